@@ -1,0 +1,22 @@
+#pragma once
+// Sub-commands of the mlidar CLI. Each command file registers its options on
+// the app and returns its run function; main dispatches to the parsed one.
+#include <functional>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace mlidar::cli {
+
+struct Command {
+  CLI::App* sub = nullptr;          ///< owned by the parent CLI::App
+  std::function<int()> run;         ///< returns the process exit code
+};
+
+Command register_info(CLI::App& app);
+Command register_convert(CLI::App& app);
+
+/// All sub-commands, in the order `mlidar --help` lists them.
+std::vector<Command> register_commands(CLI::App& app);
+
+}  // namespace mlidar::cli

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs every Debian package mlidar's build, tests, benchmarks and fuzzers
+# need. Idempotent and fast: apt is called only when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build git pkg-config
+  clang libclang-rt-14-dev
+  libeigen3-dev libceres-dev libnanoflann-dev robin-map-dev libtbb-dev
+  libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev liblzf-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$package" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$package")
+done
+
+if ((${#missing[@]} == 0)); then
+  echo "install_deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install_deps: installing ${missing[*]}"
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,188 @@
+#include "mlidar/io/point_table.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <utility>
+
+#include "mlidar/core/error.hpp"
+
+namespace mlidar::io {
+
+std::size_t scalar_size(ScalarType type) {
+  switch (type) {
+    case ScalarType::kI8:
+    case ScalarType::kU8: return 1;
+    case ScalarType::kI16:
+    case ScalarType::kU16: return 2;
+    case ScalarType::kI32:
+    case ScalarType::kU32:
+    case ScalarType::kF32: return 4;
+    case ScalarType::kI64:
+    case ScalarType::kU64:
+    case ScalarType::kF64: return 8;
+  }
+  return 0;
+}
+
+const char* scalar_name(ScalarType type) {
+  switch (type) {
+    case ScalarType::kI8: return "int8";
+    case ScalarType::kU8: return "uint8";
+    case ScalarType::kI16: return "int16";
+    case ScalarType::kU16: return "uint16";
+    case ScalarType::kI32: return "int32";
+    case ScalarType::kU32: return "uint32";
+    case ScalarType::kI64: return "int64";
+    case ScalarType::kU64: return "uint64";
+    case ScalarType::kF32: return "float32";
+    case ScalarType::kF64: return "float64";
+  }
+  return "?";
+}
+
+bool is_float(ScalarType type) { return type == ScalarType::kF32 || type == ScalarType::kF64; }
+
+namespace {
+template <typename T>
+double load(const std::byte* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return static_cast<double>(v);
+}
+}  // namespace
+
+double FieldColumn::value(std::size_t point, std::uint32_t element) const {
+  const std::byte* p = data.data() + point * stride() + element * scalar_size(type);
+  switch (type) {
+    case ScalarType::kI8: return load<std::int8_t>(p);
+    case ScalarType::kU8: return load<std::uint8_t>(p);
+    case ScalarType::kI16: return load<std::int16_t>(p);
+    case ScalarType::kU16: return load<std::uint16_t>(p);
+    case ScalarType::kI32: return load<std::int32_t>(p);
+    case ScalarType::kU32: return load<std::uint32_t>(p);
+    case ScalarType::kI64: return load<std::int64_t>(p);
+    case ScalarType::kU64: return load<std::uint64_t>(p);
+    case ScalarType::kF32: return load<float>(p);
+    case ScalarType::kF64: return load<double>(p);
+  }
+  return 0.0;
+}
+
+const FieldColumn* PointTable::find(const std::string& name) const {
+  for (const auto& f : fields) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+FieldColumn* PointTable::find(const std::string& name) {
+  return const_cast<FieldColumn*>(std::as_const(*this).find(name));
+}
+
+FieldColumn& PointTable::add_field(const std::string& name, ScalarType type, std::uint32_t count) {
+  FieldColumn column;
+  column.name = name;
+  column.type = type;
+  column.count = count;
+  column.data.resize(num_points * column.stride());
+  fields.push_back(std::move(column));
+  return fields.back();
+}
+
+namespace {
+
+const FieldColumn* find_first(const PointTable& table, const auto& names) {
+  for (const char* name : names) {
+    if (const FieldColumn* f = table.find(name)) return f;
+  }
+  return nullptr;
+}
+
+double unit_scale(TimeUnit unit) {
+  switch (unit) {
+    case TimeUnit::kMilliseconds: return 1e-3;
+    case TimeUnit::kMicroseconds: return 1e-6;
+    case TimeUnit::kNanoseconds: return 1e-9;
+    default: return 1.0;
+  }
+}
+
+// Sweeps last well under a second, so the span of the raw values tells the
+// unit; absolute unix times are recognised by their magnitude.
+TimeUnit detect_time_unit(double min_value, double max_value) {
+  const double span = max_value - min_value;
+  const double magnitude = std::max(std::abs(min_value), std::abs(max_value));
+  if (span > 1e6 || (span == 0.0 && magnitude > 1e17)) return TimeUnit::kNanoseconds;
+  if (span > 1e3 || (span == 0.0 && magnitude > 1e14)) return TimeUnit::kMicroseconds;
+  if (span > 2.0 || (span == 0.0 && magnitude > 1e11)) return TimeUnit::kMilliseconds;
+  return TimeUnit::kSeconds;
+}
+
+}  // namespace
+
+Scan to_scan(const PointTable& table, const std::string& source, const ScanOptions& options) {
+  const FieldColumn* fx = table.find("x");
+  const FieldColumn* fy = table.find("y");
+  const FieldColumn* fz = table.find("z");
+  for (const auto& [column, name] : {std::pair{fx, "x"}, std::pair{fy, "y"}, std::pair{fz, "z"}}) {
+    if (column == nullptr) throw InputError(source, std::string("field ") + name, "missing (a point cloud needs fields x, y and z)");
+  }
+  const FieldColumn* fi = table.find("intensity");
+  if (fi == nullptr) fi = table.find("reflectance");
+  const FieldColumn* fr = find_first(table, kRingFieldNames);
+  const FieldColumn* ft = find_first(table, kTimeFieldNames);
+
+  Scan scan;
+  scan.points.reserve(table.num_points);
+  std::vector<double> raw_time;
+  for (std::size_t i = 0; i < table.num_points; ++i) {
+    const Eigen::Vector3d p(fx->value(i), fy->value(i), fz->value(i));
+    if (!p.allFinite() && options.drop_nan) continue;
+    scan.points.push_back(p.cast<float>());
+    if (fi != nullptr) scan.intensity.push_back(static_cast<float>(fi->value(i)));
+    if (fr != nullptr) scan.ring.push_back(static_cast<std::uint16_t>(fr->value(i)));
+    if (ft != nullptr) raw_time.push_back(ft->value(i));
+  }
+  if (!raw_time.empty()) {
+    const auto [lo, hi] = std::minmax_element(raw_time.begin(), raw_time.end());
+    const TimeUnit unit = options.time_unit == TimeUnit::kAuto ? detect_time_unit(*lo, *hi) : options.time_unit;
+    const double scale = unit_scale(unit);
+    const double start = *lo;
+    if (!std::isfinite(start) || !std::isfinite(*hi)) {
+      throw InputError(source, "field " + ft->name, "holds non-finite times");
+    }
+    // A start far from zero means the field held absolute times: keep it as the stamp.
+    if (std::abs(start * scale) > 1e6) scan.stamp = start * scale;
+    scan.time.reserve(raw_time.size());
+    for (double t : raw_time) scan.time.push_back(static_cast<float>((t - start) * scale));
+  }
+  return scan;
+}
+
+PointTable from_scan(const Scan& scan) {
+  PointTable table;
+  table.num_points = scan.size();
+  table.width = static_cast<std::uint32_t>(scan.size());
+  table.height = 1;
+  const std::size_t n = scan.size();
+  for (int axis = 0; axis < 3; ++axis) {
+    FieldColumn& column = table.add_field(std::string(1, "xyz"[axis]), ScalarType::kF32);
+    auto* out = reinterpret_cast<float*>(column.data.data());
+    for (std::size_t i = 0; i < n; ++i) out[i] = scan.points[i][axis];
+  }
+  if (scan.has_intensity()) {
+    std::memcpy(table.add_field("intensity", ScalarType::kF32).data.data(), scan.intensity.data(), n * sizeof(float));
+  }
+  if (scan.has_ring()) {
+    std::memcpy(table.add_field("ring", ScalarType::kU16).data.data(), scan.ring.data(), n * sizeof(std::uint16_t));
+  }
+  if (scan.has_time()) {
+    auto* out = reinterpret_cast<double*>(table.add_field("t", ScalarType::kF64).data.data());
+    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<double>(scan.time[i]);
+  }
+  return table;
+}
+
+}  // namespace mlidar::io

@@ -1,0 +1,71 @@
+#pragma once
+// A format-neutral point cloud as read from a file: named, typed columns
+// (one per field, structure of arrays) so every reader and writer can keep
+// every field bit for bit. Conversion to the algorithms' Scan is explicit.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mlidar/core/types.hpp"
+
+namespace mlidar::io {
+
+enum class ScalarType : std::uint8_t { kI8, kU8, kI16, kU16, kI32, kU32, kI64, kU64, kF32, kF64 };
+
+/// Bytes per scalar of this type.
+std::size_t scalar_size(ScalarType type);
+/// "int8", "uint16", "float32", ...
+const char* scalar_name(ScalarType type);
+bool is_float(ScalarType type);
+
+/// One field: `count` scalars of `type` per point, stored point-major
+/// (point i occupies bytes [i*count*size, (i+1)*count*size)). Host byte order.
+struct FieldColumn {
+  std::string name;
+  ScalarType type = ScalarType::kF32;
+  std::uint32_t count = 1;
+  std::vector<std::byte> data;
+
+  std::size_t stride() const { return scalar_size(type) * count; }
+  /// Element `element` of point `point`, converted to double.
+  double value(std::size_t point, std::uint32_t element = 0) const;
+};
+
+struct PointTable {
+  std::size_t num_points = 0;
+  std::uint32_t width = 0;   ///< organised clouds: width x height == num_points
+  std::uint32_t height = 1;
+  std::vector<FieldColumn> fields;
+
+  const FieldColumn* find(const std::string& name) const;
+  FieldColumn* find(const std::string& name);
+  /// Appends an empty column sized for num_points and returns it.
+  FieldColumn& add_field(const std::string& name, ScalarType type, std::uint32_t count = 1);
+};
+
+/// Units of a per-point time field.
+enum class TimeUnit : std::uint8_t { kAuto, kSeconds, kMilliseconds, kMicroseconds, kNanoseconds };
+
+struct ScanOptions {
+  bool drop_nan = true;               ///< drop points whose x, y or z is not finite
+  TimeUnit time_unit = TimeUnit::kAuto;
+};
+
+/// Names looked up for the time and ring channels, in order of preference.
+inline constexpr const char* kTimeFieldNames[] = {"t", "time", "timestamp", "offset_time"};
+inline constexpr const char* kRingFieldNames[] = {"ring", "laser_id"};
+
+/// Builds a Scan: x y z required (InputError naming `source` otherwise),
+/// intensity, ring and time mapped when present. Times become seconds
+/// relative to the earliest point; units are detected from their span when
+/// options.time_unit is kAuto (span > 1e6 -> ns, > 1e3 -> us, else seconds
+/// unless absolute unix seconds). Scan::stamp takes the absolute start when
+/// the field held absolute times.
+Scan to_scan(const PointTable& table, const std::string& source, const ScanOptions& options = {});
+
+/// Inverse of to_scan: fields x y z (float32), intensity (float32), ring (uint16), t (float64 seconds).
+PointTable from_scan(const Scan& scan);
+
+}  // namespace mlidar::io

@@ -1,0 +1,35 @@
+#pragma once
+// Helpers shared by the tests: where the shared real data lives, scratch folders.
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace mlidar::test {
+
+/// ../shared/data (MLIDAR_SHARED_DATA set by CMake); empty path when absent.
+inline std::filesystem::path shared_data() {
+  const char* env = std::getenv("MLIDAR_SHARED_DATA");
+  std::filesystem::path path = env != nullptr ? env : "";
+  return std::filesystem::is_directory(path / "real") ? path : std::filesystem::path{};
+}
+
+/// Skips the current test with a clear message when the shared data is missing.
+#define MLIDAR_REQUIRE_SHARED_DATA()                                                        \
+  do {                                                                                      \
+    if (::mlidar::test::shared_data().empty())                                              \
+      GTEST_SKIP() << "shared real data not found (set MLIDAR_SHARED_DATA to ../shared/data)"; \
+  } while (0)
+
+/// A fresh empty folder under the system temp dir, unique per test.
+inline std::filesystem::path scratch_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / "mlidar_tests" /
+                              (std::string(info->test_suite_name()) + "." + info->name());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace mlidar::test
