@@ -4,6 +4,8 @@
 #include <limits>
 #include <random>
 
+#include <liblzf/lzf.h>
+
 #include "mlidar/io/file_bytes.hpp"
 #include "test_pcd_support.hpp"
 #include "test_support.hpp"
@@ -117,6 +119,26 @@ TEST(PcdRoundTrip, WriteAndReadFilesInEveryEncoding) {
     expect_same_table(expected_after_round_trip(cloud.table, encoding), read_pcd(path).table);
     EXPECT_TRUE(read_file_bytes(path) == encode_pcd(cloud));
   }
+}
+
+// PCL leaves padding columns out of the LZF block; a block holding them is read too.
+TEST(PcdRoundTrip, CompressedBlockWithPaddingColumnsKeepsThem) {
+  PcdCloud cloud = every_type_cloud(PcdEncoding::kBinaryCompressed, 9);
+  std::vector<std::byte> block;
+  for (const FieldColumn& column : cloud.table.fields) block.insert(block.end(), column.data.begin(), column.data.end());
+  std::vector<std::byte> compressed(block.size() * 2 + 64);
+  const unsigned int compressed_size = lzf_compress(block.data(), static_cast<unsigned int>(block.size()), compressed.data(),
+                                                    static_cast<unsigned int>(compressed.size()));
+  ASSERT_GT(compressed_size, 0u);
+  const std::vector<std::byte> pcl_style = encode_pcd(cloud);
+  const std::string marker = "DATA binary_compressed\n";
+  const std::string text(reinterpret_cast<const char*>(pcl_style.data()), pcl_style.size());
+  std::vector<std::byte> file(pcl_style.begin(), pcl_style.begin() + static_cast<std::ptrdiff_t>(text.find(marker) + marker.size()));
+  const std::uint32_t sizes[2] = {compressed_size, static_cast<std::uint32_t>(block.size())};
+  const auto* size_bytes = reinterpret_cast<const std::byte*>(sizes);
+  file.insert(file.end(), size_bytes, size_bytes + sizeof(sizes));
+  file.insert(file.end(), compressed.begin(), compressed.begin() + compressed_size);
+  expect_same_table(cloud.table, parse_pcd(file, "memory").table);
 }
 
 TEST(PcdRoundTrip, EmptyCloudInEveryEncoding) {

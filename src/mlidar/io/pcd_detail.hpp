@@ -55,6 +55,9 @@ void decode_ascii_body(std::span<const std::byte> body, const PcdHeader& header,
                        PointTable& table);
 void append_ascii_body(const PointTable& table, std::vector<std::byte>& out);
 
+/// Field names are words: non-empty, no spaces or control characters (UTF-8 is fine).
+bool is_valid_field_name(std::string_view name);
+
 /// A printable, length-limited copy of untrusted text for error messages.
 std::string printable(std::string_view text);
 

@@ -159,6 +159,9 @@ class HeaderParser {
     for (std::size_t i = 0; i < names.size(); ++i) {
       PcdField field;
       field.name = std::string(names[i]);
+      if (!is_valid_field_name(field.name)) {
+        fail(kFields, "name " + printable(field.name) + " holds a control character (expected printable names)");
+      }
       if (!field.is_padding() && !unique_names.insert(names[i]).second) {
         fail(kFields, "names " + printable(names[i]) + " twice (expected unique names; only the padding field _ may repeat)");
       }
@@ -255,6 +258,13 @@ const char* type_letter(ScalarType type) {
 }
 
 }  // namespace
+
+bool is_valid_field_name(std::string_view name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    const auto byte = static_cast<unsigned char>(c);
+    return byte > 0x20 && byte != 0x7f;
+  });
+}
 
 std::string printable(std::string_view text) {
   constexpr std::size_t kMaxShown = 40;

@@ -105,7 +105,8 @@ void decode_compressed_body(std::span<const std::byte> body, const PcdHeader& he
   table = pcd_detail::make_table(header);
   std::size_t offset = 0;
   for (FieldColumn& column : table.fields) {
-    if (column.name == pcd_detail::kPaddingName && !has_padding_columns) continue;  // stays zero
+    const bool left_out = column.name == pcd_detail::kPaddingName && !has_padding_columns;
+    if (left_out || column.data.empty()) continue;  // padding left out stays zero
     std::memcpy(column.data.data(), decoded.get() + offset, column.data.size());
     offset += column.data.size();
   }

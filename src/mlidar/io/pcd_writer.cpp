@@ -20,19 +20,11 @@ struct Dimensions {
   std::uint32_t height = 1;
 };
 
-bool is_valid_name(const std::string& name) {
-  if (name.empty()) return false;
-  for (char c : name) {
-    if (static_cast<unsigned char>(c) <= 0x20 || c == 0x7f || c == '#') return false;
-  }
-  return true;
-}
-
 // A table that cannot be written is a programmer error: say which column is wrong.
 Dimensions check_writable(const PointTable& table) {
   if (table.fields.empty()) throw std::invalid_argument("encode_pcd: the point table has no fields");
   for (const FieldColumn& column : table.fields) {
-    if (!is_valid_name(column.name)) throw std::invalid_argument("encode_pcd: field name '" + column.name + "' is empty or has spaces");
+    if (!pcd_detail::is_valid_field_name(column.name)) throw std::invalid_argument("encode_pcd: field name '" + column.name + "' is empty or has spaces");
     if (column.count == 0) throw std::invalid_argument("encode_pcd: field '" + column.name + "' has count 0");
     if (column.data.size() != table.num_points * column.stride()) {
       throw std::invalid_argument("encode_pcd: field '" + column.name + "' holds " + std::to_string(column.data.size()) +
