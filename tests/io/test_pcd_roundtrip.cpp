@@ -226,6 +226,10 @@ TEST(PcdRoundTrip, EncodingRejectsInconsistentTables) {
   cloud.table.height = 1;
   cloud.table.fields[0].name = "has space";
   EXPECT_THROW(encode_pcd(cloud), std::invalid_argument);
+  cloud.table.fields[0].name = "x";
+  EXPECT_NO_THROW(encode_pcd(cloud));
+  cloud.table.fields.push_back(cloud.table.fields[0]);  // a second x
+  EXPECT_THROW(encode_pcd(cloud), std::invalid_argument);
 }
 
 TEST(PcdRoundTrip, EncodingNames) {

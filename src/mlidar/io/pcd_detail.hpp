@@ -44,9 +44,6 @@ struct PcdHeader {
 /// points * record_size and points * values_per_point fit in 64 bits.
 PcdHeader parse_pcd_header(std::span<const std::byte> bytes, const std::string& source);
 
-/// The header text (ending with the DATA line) for a validated cloud.
-std::string format_pcd_header(const PcdCloud& cloud, std::uint32_t width, std::uint32_t height);
-
 /// Column-sized, zero-filled table for the header's fields and points.
 PointTable make_table(const PcdHeader& header);
 

@@ -1,4 +1,4 @@
-// PCD header: parsing with strict validation, and formatting for the writer.
+// PCD header: parsing with strict validation of every line and size.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -240,23 +240,6 @@ class HeaderParser {
   PcdHeader header_;
 };
 
-void append_double(std::string& out, double value) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  out.append(buffer.data(), result.ptr);
-}
-
-const char* type_letter(ScalarType type) {
-  if (is_float(type)) return "F";
-  switch (type) {
-    case ScalarType::kI8:
-    case ScalarType::kI16:
-    case ScalarType::kI32:
-    case ScalarType::kI64: return "I";
-    default: return "U";
-  }
-}
-
 }  // namespace
 
 bool is_valid_field_name(std::string_view name) {
@@ -279,28 +262,6 @@ std::string printable(std::string_view text) {
 
 PcdHeader parse_pcd_header(std::span<const std::byte> bytes, const std::string& source) {
   return HeaderParser(bytes, source).parse();
-}
-
-std::string format_pcd_header(const PcdCloud& cloud, std::uint32_t width, std::uint32_t height) {
-  std::string names = "FIELDS", sizes = "\nSIZE", types = "\nTYPE", counts = "\nCOUNT";
-  for (const FieldColumn& column : cloud.table.fields) {
-    (names += ' ') += column.name;
-    (sizes += ' ') += std::to_string(scalar_size(column.type));
-    (types += ' ') += type_letter(column.type);
-    (counts += ' ') += std::to_string(column.count);
-  }
-  std::string out = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
-  out.append(names).append(sizes).append(types).append(counts);
-  out.append("\nWIDTH ").append(std::to_string(width));
-  out.append("\nHEIGHT ").append(std::to_string(height));
-  out.append("\nVIEWPOINT");
-  for (double value : cloud.viewpoint) {
-    out += ' ';
-    append_double(out, value);
-  }
-  out.append("\nPOINTS ").append(std::to_string(cloud.table.num_points));
-  out.append("\nDATA ").append(pcd_encoding_name(cloud.encoding)).append("\n");
-  return out;
 }
 
 PointTable make_table(const PcdHeader& header) {

@@ -1,8 +1,11 @@
 // PCD v0.7 writer: header, then packed records (binary), an LZF block of
 // columns (binary_compressed, padding fields left out as PCL does) or text rows.
+#include <array>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <stdexcept>
 
 #include <liblzf/lzf.h>
@@ -23,8 +26,14 @@ struct Dimensions {
 // A table that cannot be written is a programmer error: say which column is wrong.
 Dimensions check_writable(const PointTable& table) {
   if (table.fields.empty()) throw std::invalid_argument("encode_pcd: the point table has no fields");
+  std::set<std::string> names;
   for (const FieldColumn& column : table.fields) {
-    if (!pcd_detail::is_valid_field_name(column.name)) throw std::invalid_argument("encode_pcd: field name '" + column.name + "' is empty or has spaces");
+    if (!pcd_detail::is_valid_field_name(column.name)) {
+      throw std::invalid_argument("encode_pcd: field name '" + column.name + "' is empty or has spaces or control characters");
+    }
+    if (column.name != pcd_detail::kPaddingName && !names.insert(column.name).second) {
+      throw std::invalid_argument("encode_pcd: field name '" + column.name + "' repeats (only padding _ may)");
+    }
     if (column.count == 0) throw std::invalid_argument("encode_pcd: field '" + column.name + "' has count 0");
     if (column.data.size() != table.num_points * column.stride()) {
       throw std::invalid_argument("encode_pcd: field '" + column.name + "' holds " + std::to_string(column.data.size()) +
@@ -42,6 +51,46 @@ Dimensions check_writable(const PointTable& table) {
     return {table.width, table.height};
   }
   return {static_cast<std::uint32_t>(table.num_points), 1};
+}
+
+void append_double(std::string& out, double value) {
+  std::array<char, 32> buffer{};
+  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  out.append(buffer.data(), result.ptr);
+}
+
+const char* type_letter(ScalarType type) {
+  if (is_float(type)) return "F";
+  switch (type) {
+    case ScalarType::kI8:
+    case ScalarType::kI16:
+    case ScalarType::kI32:
+    case ScalarType::kI64: return "I";
+    default: return "U";
+  }
+}
+
+// The header text, ending with the DATA line, for a validated cloud.
+std::string format_header(const PcdCloud& cloud, std::uint32_t width, std::uint32_t height) {
+  std::string names = "FIELDS", sizes = "\nSIZE", types = "\nTYPE", counts = "\nCOUNT";
+  for (const FieldColumn& column : cloud.table.fields) {
+    (names += ' ') += column.name;
+    (sizes += ' ') += std::to_string(scalar_size(column.type));
+    (types += ' ') += type_letter(column.type);
+    (counts += ' ') += std::to_string(column.count);
+  }
+  std::string out = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
+  out.append(names).append(sizes).append(types).append(counts);
+  out.append("\nWIDTH ").append(std::to_string(width));
+  out.append("\nHEIGHT ").append(std::to_string(height));
+  out.append("\nVIEWPOINT");
+  for (double value : cloud.viewpoint) {
+    out += ' ';
+    append_double(out, value);
+  }
+  out.append("\nPOINTS ").append(std::to_string(cloud.table.num_points));
+  out.append("\nDATA ").append(pcd_encoding_name(cloud.encoding)).append("\n");
+  return out;
 }
 
 template <std::size_t kStride>
@@ -114,7 +163,7 @@ std::vector<std::byte> encode_pcd(const PcdCloud& cloud) {
   for (double value : cloud.viewpoint) {
     if (!std::isfinite(value)) throw std::invalid_argument("encode_pcd: the viewpoint holds a non-finite value");
   }
-  const std::string header = pcd_detail::format_pcd_header(cloud, dims.width, dims.height);
+  const std::string header = format_header(cloud, dims.width, dims.height);
   std::vector<std::byte> out;
   const auto* header_bytes = reinterpret_cast<const std::byte*>(header.data());
   out.insert(out.end(), header_bytes, header_bytes + header.size());
