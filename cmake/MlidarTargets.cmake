@@ -14,16 +14,18 @@ function(mlidar_library name)
 endfunction()
 
 # mlidar_test(NAME SOURCES... DEPS ...): one GoogleTest program registered with ctest.
-# Tests find the shared real data through MLIDAR_SHARED_DATA (../shared/data by default).
+# Tests find the shared real data and the mlidar executable through compiled-in
+# defaults (MLIDAR_TEST_SHARED_DATA, MLIDAR_TEST_BIN); the environment variables
+# MLIDAR_SHARED_DATA and MLIDAR_BIN override them.
 function(mlidar_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   mlidar_warnings(${name})
-  gtest_discover_tests(${name}
-    PROPERTIES ENVIRONMENT "MLIDAR_SHARED_DATA=${MLIDAR_SHARED_DATA};MLIDAR_BIN=$<TARGET_FILE:mlidar>"
-    DISCOVERY_TIMEOUT 60)
+  target_compile_definitions(${name} PRIVATE
+    MLIDAR_TEST_SHARED_DATA="${MLIDAR_SHARED_DATA}" MLIDAR_TEST_BIN="$<TARGET_FILE:mlidar>")
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60)
 endfunction()
 
 set(MLIDAR_SHARED_DATA "${PROJECT_SOURCE_DIR}/../shared/data" CACHE PATH "Folder of the shared real LiDAR data")

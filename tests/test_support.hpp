@@ -8,10 +8,10 @@
 
 namespace mlidar::test {
 
-/// ../shared/data (MLIDAR_SHARED_DATA set by CMake); empty path when absent.
+/// ../shared/data (MLIDAR_SHARED_DATA overrides the path CMake compiled in); empty path when absent.
 inline std::filesystem::path shared_data() {
   const char* env = std::getenv("MLIDAR_SHARED_DATA");
-  std::filesystem::path path = env != nullptr ? env : "";
+  std::filesystem::path path = env != nullptr ? env : MLIDAR_TEST_SHARED_DATA;
   return std::filesystem::is_directory(path / "real") ? path : std::filesystem::path{};
 }
 

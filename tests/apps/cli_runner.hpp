@@ -1,5 +1,5 @@
 #pragma once
-// Runs the built mlidar executable (MLIDAR_BIN, set by CMake) in a shell and
+// Runs the built mlidar executable (MLIDAR_BIN overrides the path CMake compiled in) in a shell and
 // captures its exit code and combined output.
 #include <array>
 #include <cstdio>
@@ -16,7 +16,7 @@ struct CliResult {
 
 inline CliResult run_cli(const std::string& arguments) {
   const char* bin = std::getenv("MLIDAR_BIN");
-  const std::string command = std::string(bin != nullptr ? bin : "mlidar") + " " + arguments + " 2>&1";
+  const std::string command = std::string(bin != nullptr ? bin : MLIDAR_TEST_BIN) + " " + arguments + " 2>&1";
   CliResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;

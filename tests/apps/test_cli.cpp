@@ -1,5 +1,6 @@
 // End-to-end checks of the mlidar executable: every real cloud is described,
 // conversions keep fields, bad input exits 3 and leaves nothing behind.
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 
@@ -62,7 +63,15 @@ TEST_P(InfoOnRealData, ReportsPointCountAndBounds) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Cli, InfoOnRealData, ::testing::ValuesIn(kRealClouds));
+std::string cloud_test_name(const ::testing::TestParamInfo<RealCloud>& info) {
+  std::string name = std::to_string(info.index) + "_" + fs::path(info.param.path).stem().string();
+  for (char& c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
+  }
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, InfoOnRealData, ::testing::ValuesIn(kRealClouds), cloud_test_name);
 
 TEST(CliInfo, OpenCalibTopHasRingsAndSweepTime) {
   MLIDAR_REQUIRE_SHARED_DATA();

@@ -1,6 +1,7 @@
 // 4x4 matrix files: BALM pose CSVs (stamp in the bottom-right element) and
 // single homogeneous transforms (scan_pair T_target_source.txt).
 #include <cmath>
+#include <limits>
 
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/file_bytes.hpp"
@@ -19,7 +20,8 @@ SE3 checked_rigid(const Mat4& matrix, const std::string& source, const std::stri
                          exact_number(r.determinant()) + "; expected within " + exact_number(tolerance) +
                          " of orthonormal with det +1)");
   }
-  return SE3::from_matrix(matrix);
+  // Orthonormality was checked above against this reader's tolerance; only project here.
+  return SE3::from_matrix(matrix, std::numeric_limits<double>::infinity());
 }
 
 namespace {
