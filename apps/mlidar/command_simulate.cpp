@@ -1,0 +1,133 @@
+// `mlidar simulate drive|corner`: the built-in simulator with ground truth.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <unistd.h>
+
+#include "apps/mlidar/commands.hpp"
+#include "mlidar/core/error.hpp"
+#include "mlidar/io/trajectory_io.hpp"
+#include "mlidar/sim/corner_dataset.hpp"
+#include "mlidar/sim/drive_dataset.hpp"
+
+namespace mlidar::cli {
+namespace {
+
+struct DriveOptions {
+  std::string rig = "rv";
+  std::string scene = "campus";
+  std::string trajectory = "vehicle";
+  int frames = 100;
+  std::uint64_t seed = 1;
+  std::string perturb = "0,0";
+  std::string out;
+};
+
+struct CornerOptions {
+  sim::CornerSpec spec;
+  std::string angles = "60:120";
+  std::string out;
+};
+
+/// "A,B" or "A:B[:C]" into numbers; UsageError naming the option otherwise.
+std::vector<double> split_numbers(const std::string& text, char separator, const std::string& option) {
+  std::vector<double> values;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    const std::size_t end = std::min(text.find(separator, begin), text.size());
+    try {
+      std::size_t used = 0;
+      const std::string part = text.substr(begin, end - begin);
+      values.push_back(std::stod(part, &used));
+      if (used != part.size()) throw std::invalid_argument(part);
+    } catch (const std::exception&) {
+      throw UsageError(option + " '" + text + "': expected numbers separated by '" + separator + "'");
+    }
+    begin = end + 1;
+  }
+  return values;
+}
+
+sim::SimTrajectory load_trajectory(const std::string& name, double base_height) {
+  for (const auto& known : sim::trajectory_names()) {
+    if (name == known) return sim::SimTrajectory::named(name, base_height);
+  }
+  if (!std::filesystem::is_regular_file(name)) return sim::SimTrajectory::named(name, base_height);  // UsageError
+  return sim::SimTrajectory::through(io::read_tum(name));
+}
+
+/// A progress bar on stderr when it is a terminal; nothing otherwise.
+sim::ProgressFn progress_bar() {
+  if (isatty(fileno(stderr)) == 0) return {};
+  return [](int done, int total) {
+    const int width = 40;
+    const int filled = width * done / total;
+    std::fprintf(stderr, "\r[%s%s] %d/%d frames", std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                 std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), done, total);
+    if (done == total) std::fputc('\n', stderr);
+  };
+}
+
+int run_drive(const DriveOptions& options) {
+  sim::DriveSpec spec;
+  spec.rig = sim::load_rig(options.rig);
+  spec.scene = options.scene;
+  spec.trajectory = load_trajectory(options.trajectory, spec.rig.base_height);
+  spec.frames = options.frames;
+  spec.seed = options.seed;
+  const auto perturb = split_numbers(options.perturb, ',', "--perturb");
+  if (perturb.size() != 2 || perturb[0] < 0.0 || perturb[1] < 0.0) throw UsageError("--perturb expects DEG,M (two non-negative numbers)");
+  spec.perturb_deg = perturb[0];
+  spec.perturb_m = perturb[1];
+  sim::write_drive_dataset(spec, options.out, progress_bar());
+  std::cout << "wrote " << options.out << ": " << spec.frames << " frames of " << spec.rig.lidars.size()
+            << " LiDAR(s), rig " << spec.rig.name << ", scene " << spec.scene << ", trajectory " << options.trajectory << '\n';
+  return 0;
+}
+
+int run_corner(CornerOptions& options) {
+  const auto angles = split_numbers(options.angles, ':', "--angles");
+  if (angles.size() < 2 || angles.size() > 3) throw UsageError("--angles expects A:B or A:B:STEP (degrees)");
+  options.spec.angle_min = angles[0];
+  options.spec.angle_max = angles[1];
+  if (angles.size() == 3) options.spec.angle_step = angles[2];
+  sim::write_corner_dataset(options.spec, options.out);
+  std::cout << "wrote " << options.out << ": two-LiDAR wall-corner clouds (thesis Table 2.2 protocol)\n";
+  return 0;
+}
+
+}  // namespace
+
+Command register_simulate(CLI::App& app) {
+  CLI::App* sub = app.add_subcommand("simulate", "Simulate a multi-LiDAR dataset with ground truth");
+  sub->require_subcommand(1);
+
+  auto drive = std::make_shared<DriveOptions>();
+  CLI::App* drive_cmd = sub->add_subcommand("drive", "A rig moving through a scene: scans, trajectory, extrinsics, boxes");
+  drive_cmd->add_option("--rig", drive->rig, "rhd, rv, lyft, single-vlp16, single-hdl64, or a rig .yaml")->capture_default_str();
+  drive_cmd->add_option("--scene", drive->scene, "corner, room, corridor, campus, street")->capture_default_str();
+  drive_cmd->add_option("--trajectory", drive->trajectory, "handheld, vehicle, corridor, static, or a TUM file")->capture_default_str();
+  drive_cmd->add_option("--frames", drive->frames, "Number of frames")->capture_default_str();
+  drive_cmd->add_option("--seed", drive->seed, "Random seed (same seed, same bytes)")->capture_default_str();
+  drive_cmd->add_option("--perturb", drive->perturb, "Perturb the initial extrinsics: DEG,M")->capture_default_str();
+  drive_cmd->add_option("--out", drive->out, "Output folder (must not exist or be empty)")->required();
+
+  auto corner = std::make_shared<CornerOptions>();
+  CLI::App* corner_cmd = sub->add_subcommand("corner", "Thesis Table 2.2 protocol: two clouds of three planes");
+  corner_cmd->add_option("--out", corner->out, "Output folder (must not exist or be empty)")->required();
+  corner_cmd->add_option("--seed", corner->spec.seed, "Random seed")->capture_default_str();
+  corner_cmd->add_option("--noise", corner->spec.noise, "Plane noise sigma (m)")->capture_default_str();
+  corner_cmd->add_option("--outliers", corner->spec.outliers, "Outlier points per cloud")->capture_default_str();
+  corner_cmd->add_option("--points", corner->spec.points, "Points per cloud, outliers included")->capture_default_str();
+  corner_cmd->add_option("--angles", corner->angles, "Wall angles A:B[:STEP] in degrees (one frame each, step 10)")->capture_default_str();
+  corner_cmd->add_option("--configuration", corner->spec.configuration, "Ground truth: 1 or 2 (Table 2.2), 0 random")->capture_default_str();
+
+  return {sub, [drive, corner, drive_cmd] {
+            if (drive_cmd->parsed()) return run_drive(*drive);
+            return run_corner(*corner);
+          }};
+}
+
+}  // namespace mlidar::cli

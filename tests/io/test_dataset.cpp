@@ -1,0 +1,88 @@
+// dataset.yaml and times.txt: round trips and errors that name the key.
+#include <gtest/gtest.h>
+
+#include "mlidar/core/error.hpp"
+#include "mlidar/io/dataset.hpp"
+#include "test_support.hpp"
+
+namespace mlidar::io {
+namespace {
+
+Dataset example() {
+  Dataset dataset;
+  dataset.name = "rv-campus";
+  dataset.frame_period = 0.1;
+  dataset.base = "top";
+  DatasetLidar top;
+  top.name = "top";
+  top.model.name = "RS-LiDAR-16";
+  top.model.vertical_angles_deg = {-15.0, -13.0, 0.1 + 0.2};
+  top.model.horizontal_resolution_deg = 0.2;
+  top.scans = "scans/top";
+  top.initial_extrinsic = SE3(so3_exp(Vec3(0.1, 0.2, -0.3)), Vec3(0.8, 1.0 / 3.0, -1.36));
+  DatasetLidar front = top;
+  front.name = "front";
+  front.scans = "scans/front";
+  front.initial_extrinsic.reset();
+  dataset.lidars = {top, front};
+  dataset.groundtruth.trajectory = "groundtruth/trajectory.tum";
+  dataset.groundtruth.boxes = "groundtruth/boxes";
+  return dataset;
+}
+
+TEST(Dataset, YamlRoundTripIsExact) {
+  const Dataset original = example();
+  const auto dir = test::scratch_dir();
+  write_dataset_yaml(dir / "dataset.yaml", original);
+  const Dataset read = read_dataset_yaml(dir);
+  EXPECT_EQ(read.name, original.name);
+  EXPECT_EQ(read.frame_period, original.frame_period);
+  EXPECT_EQ(read.base, "top");
+  ASSERT_EQ(read.lidars.size(), 2u);
+  EXPECT_EQ(read.lidars[0].model.vertical_angles_deg, original.lidars[0].model.vertical_angles_deg);
+  EXPECT_EQ(read.lidars[0].scans, "scans/top");
+  ASSERT_TRUE(read.lidars[0].initial_extrinsic);
+  EXPECT_EQ(read.lidars[0].initial_extrinsic->translation(), original.lidars[0].initial_extrinsic->translation());
+  EXPECT_EQ(read.lidars[0].initial_extrinsic->rotation().coeffs(), original.lidars[0].initial_extrinsic->rotation().coeffs());
+  EXPECT_FALSE(read.lidars[1].initial_extrinsic);
+  EXPECT_EQ(read.groundtruth.boxes, std::filesystem::path("groundtruth/boxes"));
+  EXPECT_FALSE(read.groundtruth.extrinsics);
+  EXPECT_EQ(format_dataset_yaml(read), format_dataset_yaml(original));
+}
+
+TEST(Dataset, ErrorsNameTheKey) {
+  auto expect_key = [](const std::string& text, const std::string& key) {
+    try {
+      parse_dataset_yaml(text, "d.yaml");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), key) << e.what();
+    }
+  };
+  const std::string head = "name: x\nframe_period: 0.1\n";
+  expect_key("name: x\n", "frame_period");
+  expect_key(head, "lidars");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s}]\ncolour: red\n", "colour");
+  expect_key(head + "lidars: [{name: a, model: m}]\n", "lidars[0].scans");
+  expect_key(head + "lidars: [{name: a, model: m, scans: ../../etc}]\n", "lidars[0].scans");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s}, {name: a, model: m, scans: t}]\n", "lidars[1].name");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, initial_extrinsic: {translation: [1, 2, 3], quaternion_wxyz: [2, 0, 0, 0]}}]\n",
+             "lidars[0].initial_extrinsic.quaternion_wxyz");
+  expect_key("name: x\nframe_period: -1\nlidars: [{name: a, model: m, scans: s}]\n", "frame_period");
+  expect_key("{", "(document)");
+}
+
+TEST(Dataset, TimesRoundTripAndValidation) {
+  const std::vector<double> stamps{0.0, 0.1, 0.2 + 1e-12, 1234567890.123456789};
+  const auto dir = test::scratch_dir();
+  write_times(dir / "times.txt", stamps);
+  EXPECT_EQ(read_times(dir / "times.txt"), stamps);
+  EXPECT_EQ(parse_times("# comment\n1\n\n2.5\n", "t"), (std::vector<double>{1.0, 2.5}));
+  EXPECT_THROW(parse_times("1\n1\n", "t"), InputError);
+  EXPECT_THROW(parse_times("1\nabc\n", "t"), InputError);
+  EXPECT_THROW(parse_times("1 2\n", "t"), InputError);
+  EXPECT_THROW(parse_times("nan\n", "t"), InputError);
+}
+
+}  // namespace
+}  // namespace mlidar::io
