@@ -1,0 +1,84 @@
+#include "mlidar/eval/map_metrics.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
+#include "mlidar/geometry/kdtree.hpp"
+
+namespace mlidar::eval {
+namespace {
+
+struct LocalSpread {
+  double entropy = 0.0;         ///< 1/2 ln |2 pi e Sigma|
+  double smallest_variance = 0.0;
+};
+
+/// Sample covariance of the neighbours, accumulated relative to the query
+/// point (offsets are <= radius, so the sums do not cancel catastrophically).
+Eigen::Matrix3d neighbour_covariance(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& query,
+                                     const std::vector<Neighbor>& neighbors) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
+  for (const Neighbor& neighbor : neighbors) {
+    const Eigen::Vector3d offset = (points[neighbor.index] - query).cast<double>();
+    sum += offset;
+    sum_outer.noalias() += offset * offset.transpose();
+  }
+  const double n = static_cast<double>(neighbors.size());
+  return (sum_outer - sum * sum.transpose() / n) / (n - 1.0);
+}
+
+/// Fills `spread`; returns false when Sigma is not full rank.
+bool local_spread(const Eigen::Matrix3d& covariance, LocalSpread& spread) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d& eigenvalues = solver.eigenvalues();  // increasing
+  if (!(eigenvalues(0) > 1e-12 * std::max(eigenvalues(2), 1e-300))) return false;
+  const double log_two_pi_e = std::log(2.0 * std::numbers::pi * std::numbers::e);
+  spread.entropy = 0.5 * (3.0 * log_two_pi_e + std::log(eigenvalues(0)) + std::log(eigenvalues(1)) +
+                          std::log(eigenvalues(2)));
+  spread.smallest_variance = eigenvalues(0);
+  return true;
+}
+
+}  // namespace
+
+MapMetrics compute_map_metrics(const std::vector<Eigen::Vector3f>& points, const MapMetricsOptions& options) {
+  if (!(options.radius > 0.0) || !std::isfinite(options.radius))
+    throw std::invalid_argument("map metrics: radius must be a finite number > 0");
+  if (options.min_neighbors < 4) throw std::invalid_argument("map metrics: min_neighbors must be >= 4");
+  std::vector<Eigen::Vector3f> finite_points;
+  finite_points.reserve(points.size());
+  for (const Eigen::Vector3f& point : points) {
+    if (point.allFinite()) finite_points.push_back(point);
+  }
+  const KdTree3f tree(std::move(finite_points));
+  const std::vector<Eigen::Vector3f>& cloud = tree.points();
+  const auto radius = static_cast<float>(options.radius);
+
+  MapMetrics metrics;
+  metrics.points = points.size();
+  double sum_entropy = 0.0;
+  double sum_plane_variance = 0.0;
+  std::vector<Neighbor> neighbors;
+  for (const Eigen::Vector3f& query : cloud) {
+    tree.radius_search_unsorted(query, radius, neighbors);
+    if (neighbors.size() < options.min_neighbors) continue;
+    LocalSpread spread;
+    if (!local_spread(neighbour_covariance(cloud, query, neighbors), spread)) continue;
+    sum_entropy += spread.entropy;
+    sum_plane_variance += spread.smallest_variance;
+    ++metrics.points_used;
+  }
+  const double used = static_cast<double>(metrics.points_used);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  metrics.mean_map_entropy = metrics.points_used > 0 ? sum_entropy / used : nan;
+  metrics.mean_plane_variance = metrics.points_used > 0 ? sum_plane_variance / used : nan;
+  return metrics;
+}
+
+}  // namespace mlidar::eval
