@@ -1,6 +1,9 @@
 #include "mlidar/eval/map_metrics.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <utility>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -11,6 +14,44 @@
 
 namespace mlidar::eval {
 namespace {
+
+constexpr std::size_t kLeafSize = 24;  // radius queries return many points: wider leaves pay off
+
+/// Interleaves the low 21 bits of x, y, z (Morton / Z-order code).
+std::uint64_t morton_code(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  std::uint64_t code = 0;
+  for (int bit = 0; bit < 21; ++bit) {
+    code |= (static_cast<std::uint64_t>((x >> bit) & 1U) << (3 * bit)) |
+            (static_cast<std::uint64_t>((y >> bit) & 1U) << (3 * bit + 1)) |
+            (static_cast<std::uint64_t>((z >> bit) & 1U) << (3 * bit + 2));
+  }
+  return code;
+}
+
+/// The finite points, reordered along a Z-order curve over cells of `cell` metres,
+/// so consecutive queries touch nearby memory (the metrics do not depend on order).
+std::vector<Eigen::Vector3f> finite_points_in_spatial_order(const std::vector<Eigen::Vector3f>& points, double cell) {
+  std::vector<Eigen::Vector3f> finite;
+  finite.reserve(points.size());
+  Eigen::Vector3f lowest = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+  for (const Eigen::Vector3f& point : points) {
+    if (!point.allFinite()) continue;
+    finite.push_back(point);
+    lowest = lowest.cwiseMin(point);
+  }
+  constexpr double kMaxCell = (1U << 21) - 1;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keys(finite.size());
+  for (std::size_t i = 0; i < finite.size(); ++i) {
+    const Eigen::Vector3d cell_index = ((finite[i] - lowest).cast<double>() / cell).cwiseMin(kMaxCell);
+    keys[i] = {morton_code(static_cast<std::uint32_t>(cell_index.x()), static_cast<std::uint32_t>(cell_index.y()),
+                           static_cast<std::uint32_t>(cell_index.z())),
+               static_cast<std::uint32_t>(i)};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<Eigen::Vector3f> ordered(finite.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) ordered[i] = finite[keys[i].second];
+  return ordered;
+}
 
 struct LocalSpread {
   double entropy = 0.0;         ///< 1/2 ln |2 pi e Sigma|
@@ -51,12 +92,9 @@ MapMetrics compute_map_metrics(const std::vector<Eigen::Vector3f>& points, const
   if (!(options.radius > 0.0) || !std::isfinite(options.radius))
     throw std::invalid_argument("map metrics: radius must be a finite number > 0");
   if (options.min_neighbors < 4) throw std::invalid_argument("map metrics: min_neighbors must be >= 4");
-  std::vector<Eigen::Vector3f> finite_points;
-  finite_points.reserve(points.size());
-  for (const Eigen::Vector3f& point : points) {
-    if (point.allFinite()) finite_points.push_back(point);
-  }
-  const KdTree3f tree(std::move(finite_points));
+  if (points.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("map metrics: too many points");
+  const KdTree3f tree(finite_points_in_spatial_order(points, options.radius), kLeafSize);
   const std::vector<Eigen::Vector3f>& cloud = tree.points();
   const auto radius = static_cast<float>(options.radius);
 
