@@ -2,6 +2,8 @@
 
 namespace mlidar::cli {
 
-std::vector<Command> register_commands(CLI::App& /*app*/) { return {}; }
+std::vector<Command> register_commands(CLI::App& app) {
+  return {register_info(app), register_convert(app)};
+}
 
 }  // namespace mlidar::cli

@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
       "Exit codes:\n"
       "  0  ok\n"
       "  1  the job ran but failed or its result should not be trusted (no convergence, degenerate)\n"
-      "  2  usage error (bad command line or configuration)\n"
+      "  2  usage error (bad command line or configuration, output that cannot be written)\n"
       "  3  bad input data (unreadable, truncated or invalid file)");
   app.require_subcommand(1);
   app.set_version_flag("--version", "mlidar 0.1.0");
@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     return static_cast<int>(ExitCode::kUsage);
   } catch (const mlidar::OutputError& e) {
     std::cerr << "mlidar: cannot write output: " << e.what() << '\n';
-    return static_cast<int>(ExitCode::kUntrusted);
+    return static_cast<int>(ExitCode::kUsage);
   } catch (const std::exception& e) {
     std::cerr << "mlidar: failed: " << e.what() << '\n';
     return static_cast<int>(ExitCode::kUntrusted);

@@ -129,8 +129,7 @@ Scan to_scan(const PointTable& table, const std::string& source, const ScanOptio
   for (const auto& [column, name] : {std::pair{fx, "x"}, std::pair{fy, "y"}, std::pair{fz, "z"}}) {
     if (column == nullptr) throw InputError(source, std::string("field ") + name, "missing (a point cloud needs fields x, y and z)");
   }
-  const FieldColumn* fi = table.find("intensity");
-  if (fi == nullptr) fi = table.find("reflectance");
+  const FieldColumn* fi = find_first(table, kIntensityFieldNames);
   const FieldColumn* fr = find_first(table, kRingFieldNames);
   const FieldColumn* ft = find_first(table, kTimeFieldNames);
 

@@ -56,6 +56,7 @@ struct ScanOptions {
 /// Names looked up for the time and ring channels, in order of preference.
 inline constexpr const char* kTimeFieldNames[] = {"t", "time", "timestamp", "offset_time"};
 inline constexpr const char* kRingFieldNames[] = {"ring", "laser_id"};
+inline constexpr const char* kIntensityFieldNames[] = {"intensity", "reflectance", "scalar_intensity", "i"};
 
 /// Builds a Scan: x y z required (InputError naming `source` otherwise),
 /// intensity, ring and time mapped when present. Times become seconds

@@ -1,0 +1,117 @@
+#include "mlidar/io/cloud_file.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include "mlidar/core/error.hpp"
+#include "mlidar/io/kitti.hpp"
+#include "mlidar/io/pcd.hpp"
+#include "mlidar/io/ply.hpp"
+
+namespace mlidar::io {
+
+const char* cloud_format_name(CloudFormat format) {
+  switch (format) {
+    case CloudFormat::kPcd: return "pcd";
+    case CloudFormat::kPly: return "ply";
+    case CloudFormat::kKittiBin: return "kitti-bin";
+  }
+  return "?";
+}
+
+namespace {
+
+std::string lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+bool ends_with(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+int guess_bin_floats(const std::filesystem::path& path) {
+  if (ends_with(lower(path.filename().string()), ".pcd.bin")) return 5;
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size % 16 != 0 && size % 20 == 0) return 5;
+  return 4;
+}
+
+PcdEncoding parse_pcd_encoding(const std::string& name) {
+  if (name == "binary") return PcdEncoding::kBinary;
+  if (name == "binary_compressed") return PcdEncoding::kBinaryCompressed;
+  if (name == "ascii") return PcdEncoding::kAscii;
+  throw UsageError("unknown PCD encoding '" + name + "' (use binary, binary_compressed or ascii)");
+}
+
+PointTable without_padding(const PointTable& table) {
+  PointTable out;
+  out.num_points = table.num_points;
+  out.width = table.width;
+  out.height = table.height;
+  for (const auto& field : table.fields) {
+    if (field.name != "_") out.fields.push_back(field);
+  }
+  return out;
+}
+
+}  // namespace
+
+CloudFormat cloud_format_of(const std::filesystem::path& path) {
+  const std::string extension = lower(path.extension().string());
+  if (extension == ".pcd") return CloudFormat::kPcd;
+  if (extension == ".ply") return CloudFormat::kPly;
+  if (extension == ".bin") return CloudFormat::kKittiBin;
+  throw InputError(path.string(), "file extension", "unknown point-cloud format '" + extension +
+                                                         "' (mlidar reads .pcd, .ply and KITTI/nuScenes .bin)");
+}
+
+CloudFile read_cloud(const std::filesystem::path& path, const CloudReadOptions& options) {
+  CloudFile cloud;
+  cloud.format = cloud_format_of(path);
+  switch (cloud.format) {
+    case CloudFormat::kPcd: {
+      PcdCloud pcd = read_pcd(path, PcdReadOptions{options.drop_nan});
+      cloud.encoding = pcd_encoding_name(pcd.encoding);
+      cloud.viewpoint = pcd.viewpoint;
+      cloud.table = std::move(pcd.table);
+      break;
+    }
+    case CloudFormat::kPly: {
+      PlyCloud ply = read_ply(path);
+      cloud.encoding = ply_encoding_name(ply.encoding);
+      cloud.table = std::move(ply.table);
+      break;
+    }
+    case CloudFormat::kKittiBin: {
+      const int floats = options.bin_floats_per_point > 0 ? options.bin_floats_per_point : guess_bin_floats(path);
+      cloud.encoding = floats == 5 ? "float32 x5 (nuScenes)" : "float32 x4 (KITTI)";
+      cloud.table = read_kitti_bin(path, floats);
+      break;
+    }
+  }
+  return cloud;
+}
+
+void write_cloud(const std::filesystem::path& path, const CloudFile& cloud, const CloudWriteOptions& options) {
+  switch (cloud_format_of(path)) {
+    case CloudFormat::kPcd: {
+      PcdCloud pcd;
+      pcd.encoding = parse_pcd_encoding(options.pcd_encoding);
+      pcd.viewpoint = cloud.viewpoint;
+      pcd.table = cloud.table;
+      write_pcd(path, pcd);
+      return;
+    }
+    case CloudFormat::kPly: {
+      PlyCloud ply;
+      ply.table = without_padding(cloud.table);
+      write_ply(path, ply);
+      return;
+    }
+    case CloudFormat::kKittiBin: write_kitti_bin(path, cloud.table); return;
+  }
+}
+
+}  // namespace mlidar::io
