@@ -1,7 +1,8 @@
 #pragma once
 // SO(3) helpers on Eigen types. Rotation vectors are axis * angle (rad).
 // Conventions: Exp/Log are the matrix exponential/logarithm of the hat map;
-// the left Jacobian J_l satisfies Exp(phi + d) ~= Exp(J_l(phi) d) Exp(phi).
+// the left Jacobian J_l satisfies Exp(phi + d) ~= Exp(J_l(phi) d) Exp(phi),
+// the right one Exp(phi + d) ~= Exp(phi) Exp(J_r(phi) d).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -20,6 +21,9 @@ Vec3 vee(const Mat3& m);
 Quat so3_exp(const Vec3& phi);
 /// Log: unit quaternion -> rotation vector with angle in [0, pi] (stable near 0 and pi).
 Vec3 so3_log(const Quat& q);
+/// Geodesic interpolation a * Exp(s * Log(a^-1 b)) along the shorter arc;
+/// s = 0 gives a, s = 1 gives b, s outside [0, 1] extrapolates.
+Quat so3_slerp(const Quat& a, const Quat& b, double s);
 
 /// Left Jacobian of SO(3) and its inverse (Barfoot, State Estimation, eq 7.77a/7.79).
 Mat3 so3_left_jacobian(const Vec3& phi);

@@ -18,4 +18,16 @@ Trajectory parse_kitti_poses(const std::string& text, const std::string& source,
 Trajectory read_kitti_poses(const std::filesystem::path& path, const std::vector<double>& stamps = {});
 void write_kitti_poses(const std::filesystem::path& path, const Trajectory& trajectory);
 
+/// BALM's pose CSV (hku-mars/BALM benchmark_realworld): four lines `a,b,c,d,`
+/// per pose holding a 4x4 T_world_lidar whose bottom-right element is the
+/// stamp (unix seconds) instead of 1.
+Trajectory parse_balm_poses(const std::string& text, const std::string& source);
+Trajectory read_balm_poses(const std::filesystem::path& path);
+
+/// One 4x4 homogeneous matrix as 16 whitespace-separated numbers, row-major
+/// (bottom row 0 0 0 1); the rotation is re-orthonormalised, and rejected
+/// when further than 1e-3 from orthonormal.
+SE3 parse_matrix_transform(const std::string& text, const std::string& source);
+SE3 read_matrix_transform(const std::filesystem::path& path);
+
 }  // namespace mlidar::io
