@@ -17,7 +17,7 @@ std::string fixed(double value, int decimals = 4) {
 
 std::string stats_row(const char* label, const ErrorStats& stats) {
   char buffer[200];
-  std::snprintf(buffer, sizeof(buffer), "%-22s %10s %10s %10s %10s\n", label, fixed(stats.rmse).c_str(),
+  std::snprintf(buffer, sizeof(buffer), "%-26s %10s %10s %10s %10s\n", label, fixed(stats.rmse).c_str(),
                 fixed(stats.mean).c_str(), fixed(stats.median).c_str(), fixed(stats.max).c_str());
   return buffer;
 }
@@ -87,11 +87,13 @@ std::string format_table(const TrajectoryReport& report) {
                      ", est " + std::to_string(report.est_poses) + "), alignment " +
                      align_mode_name(report.alignment.mode) + ", scale " + fixed(report.alignment.scale, 6) + "\n";
   char header[200];
-  std::snprintf(header, sizeof(header), "%-22s %10s %10s %10s %10s\n", "metric", "rmse", "mean", "median", "max");
+  std::snprintf(header, sizeof(header), "%-26s %10s %10s %10s %10s\n", "metric", "rmse", "mean", "median", "max");
   text += header;
   text += stats_row("ATE trans (m)", report.ate.translation_m);
   text += stats_row("ATE rot (deg)", report.ate.rotation_deg);
-  const std::string rpe = "RPE@" + fixed(report.rpe.delta, 2) + delta_unit_name(report.rpe.unit);
+  char delta[32];
+  std::snprintf(delta, sizeof(delta), "%g", report.rpe.delta);
+  const std::string rpe = std::string("RPE/") + delta + delta_unit_name(report.rpe.unit);
   text += stats_row((rpe + " trans (m)").c_str(), report.rpe.translation_m);
   text += stats_row((rpe + " trans (%)").c_str(), report.rpe.translation_percent);
   text += stats_row((rpe + " rot (deg)").c_str(), report.rpe.rotation_deg);
