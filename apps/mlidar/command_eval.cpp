@@ -1,0 +1,163 @@
+// `mlidar eval traj|calib|map`: evaluation of trajectories, extrinsics and maps
+// (definitions and JSON keys in src/mlidar/eval/report.hpp). File reading and
+// option checks live here; the metrics in mlidar::eval know nothing of files.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "apps/mlidar/commands.hpp"
+#include "mlidar/core/error.hpp"
+#include "mlidar/eval/report.hpp"
+#include "mlidar/eval/svg_plot.hpp"
+#include "mlidar/io/atomic_file.hpp"
+#include "mlidar/io/cloud_file.hpp"
+#include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/trajectory_io.hpp"
+
+namespace mlidar::cli {
+namespace {
+
+struct TrajOptions {
+  std::string gt;
+  std::string est;
+  std::string format;  ///< "tum" or "kitti"; empty: from the ground truth's extension
+  std::string align = "se3";
+  double max_dt = 0.01;
+  double delta = 1.0;
+  std::string delta_unit = "frames";
+  std::string json_out;
+  std::string plot_out;
+};
+
+struct CalibOptions {
+  std::string gt;
+  std::string est;
+  std::string json_out;
+};
+
+struct MapOptions {
+  std::string map;
+  double radius = 0.3;
+  std::size_t min_neighbors = 5;
+  std::string json_out;
+};
+
+void write_json(const std::string& path, const nlohmann::json& json) {
+  if (path.empty()) return;
+  io::write_atomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
+}
+
+eval::AlignMode parse_align(const std::string& name) {
+  if (name == "none") return eval::AlignMode::kNone;
+  if (name == "origin") return eval::AlignMode::kOrigin;
+  if (name == "se3") return eval::AlignMode::kSe3;
+  return eval::AlignMode::kSim3;  // CLI11 restricts the choices
+}
+
+/// KITTI pose files by `--format kitti` or a .kitti extension; TUM otherwise.
+bool is_kitti_format(const TrajOptions& options) {
+  if (!options.format.empty()) return options.format == "kitti";
+  return std::filesystem::path(options.gt).extension() == ".kitti";
+}
+
+Trajectory read_trajectory(const std::string& path, bool kitti) {
+  return kitti ? io::read_kitti_poses(path) : io::read_tum(path);
+}
+
+int run_traj(const TrajOptions& options) {
+  const bool kitti = is_kitti_format(options);
+  eval::TrajectoryEvalOptions eval_options;
+  eval_options.align = parse_align(options.align);
+  eval_options.associate_by_index = kitti;
+  eval_options.max_dt = options.max_dt;
+  eval_options.delta = options.delta;
+  eval_options.delta_unit = options.delta_unit == "m" ? eval::DeltaUnit::kMeters : eval::DeltaUnit::kFrames;
+  const Trajectory gt = read_trajectory(options.gt, kitti);
+  const Trajectory est = read_trajectory(options.est, kitti);
+  const eval::TrajectoryReport report = eval::evaluate_trajectory(gt, est, eval_options, options.gt, options.est);
+  std::cout << eval::format_table(report);
+  write_json(options.json_out, eval::to_json(report));
+  if (!options.plot_out.empty()) {
+    const std::string svg =
+        eval::trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
+    io::write_atomically(options.plot_out, [&](std::ostream& out) { out << svg; });
+  }
+  return 0;
+}
+
+int run_calib(const CalibOptions& options) {
+  const io::Extrinsics gt = io::read_extrinsics(options.gt);
+  const io::Extrinsics est = io::read_extrinsics(options.est);
+  const auto errors = eval::evaluate_calibration(gt, est, options.est);
+  std::cout << eval::format_table(errors);
+  write_json(options.json_out, eval::to_json(errors));
+  return 0;
+}
+
+int run_map(const MapOptions& options) {
+  if (!(options.radius > 0.0)) throw UsageError("--radius must be > 0");
+  if (options.min_neighbors < 4) throw UsageError("--min-neighbors must be >= 4 (a 3D covariance needs 4 points)");
+  const io::CloudFile cloud = io::read_cloud(options.map);
+  const Scan scan = io::to_scan(cloud.table, options.map);
+  const eval::MapMetricsOptions metrics_options{.radius = options.radius, .min_neighbors = options.min_neighbors};
+  const eval::MapMetrics metrics = eval::compute_map_metrics(scan.points, metrics_options);
+  std::cout << eval::format_table(metrics, metrics_options);
+  write_json(options.json_out, eval::to_json(metrics, metrics_options));
+  return 0;
+}
+
+void add_traj(CLI::App& eval_app, std::shared_ptr<TrajOptions> options) {
+  CLI::App* sub = eval_app.add_subcommand("traj", "ATE, RPE and the KITTI odometry metric of an estimated trajectory");
+  sub->add_option("--gt", options->gt, "Ground-truth trajectory (TUM or KITTI poses)")->required();
+  sub->add_option("--est", options->est, "Estimated trajectory, same format")->required();
+  sub->add_option("--format", options->format, "tum or kitti (default: kitti for a .kitti ground truth, else tum)")
+      ->check(CLI::IsMember({"tum", "kitti"}));
+  sub->add_option("--align", options->align, "Alignment before ATE: se3 (Horn), sim3 (Umeyama), origin, none")
+      ->check(CLI::IsMember({"se3", "sim3", "origin", "none"}))
+      ->capture_default_str();
+  sub->add_option("--max-dt", options->max_dt, "Largest stamp difference (s) of associated poses (TUM)")
+      ->capture_default_str();
+  sub->add_option("--delta", options->delta, "RPE step")->capture_default_str();
+  sub->add_option("--delta-unit", options->delta_unit, "RPE step unit: frames or m")
+      ->check(CLI::IsMember({"frames", "m"}))
+      ->capture_default_str();
+  sub->add_option("--json", options->json_out, "Write the metrics as JSON to this file");
+  sub->add_option("--plot", options->plot_out, "Write an SVG plot (top view and ATE over time) to this file");
+}
+
+void add_calib(CLI::App& eval_app, std::shared_ptr<CalibOptions> options) {
+  CLI::App* sub = eval_app.add_subcommand("calib", "Rotation/translation error and NEES of estimated extrinsics");
+  sub->add_option("--gt", options->gt, "Ground-truth extrinsics YAML")->required();
+  sub->add_option("--est", options->est, "Estimated extrinsics YAML (covariances give the NEES)")->required();
+  sub->add_option("--json", options->json_out, "Write the metrics as JSON to this file");
+}
+
+void add_map(CLI::App& eval_app, std::shared_ptr<MapOptions> options) {
+  CLI::App* sub = eval_app.add_subcommand("map", "Mean map entropy and mean plane variance of a point cloud");
+  sub->add_option("--map", options->map, "Map point cloud (PLY, PCD or .bin)")->required();
+  sub->add_option("--radius", options->radius, "Neighbourhood radius (m)")->capture_default_str();
+  sub->add_option("--min-neighbors", options->min_neighbors, "Fewest neighbours (self included) for a point to count")
+      ->capture_default_str();
+  sub->add_option("--json", options->json_out, "Write the metrics as JSON to this file");
+}
+
+}  // namespace
+
+Command register_eval(CLI::App& app) {
+  CLI::App* sub = app.add_subcommand("eval", "Evaluate trajectories, extrinsics and maps (evo / KITTI definitions)");
+  sub->require_subcommand(1);
+  auto traj = std::make_shared<TrajOptions>();
+  auto calib = std::make_shared<CalibOptions>();
+  auto map = std::make_shared<MapOptions>();
+  add_traj(*sub, traj);
+  add_calib(*sub, calib);
+  add_map(*sub, map);
+  return {sub, [sub, traj, calib, map] {
+            if (sub->got_subcommand("traj")) return run_traj(*traj);
+            if (sub->got_subcommand("calib")) return run_calib(*calib);
+            return run_map(*map);
+          }};
+}
+
+}  // namespace mlidar::cli

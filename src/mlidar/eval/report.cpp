@@ -1,0 +1,132 @@
+#include "mlidar/eval/report.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace mlidar::eval {
+namespace {
+
+nlohmann::json number_or_null(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+
+std::string fixed(double value, int decimals = 4) {
+  if (!std::isfinite(value)) return "-";
+  char buffer[48];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string stats_row(const char* label, const ErrorStats& stats) {
+  char buffer[200];
+  std::snprintf(buffer, sizeof(buffer), "%-26s %10s %10s %10s %10s\n", label, fixed(stats.rmse).c_str(),
+                fixed(stats.mean).c_str(), fixed(stats.median).c_str(), fixed(stats.max).c_str());
+  return buffer;
+}
+
+}  // namespace
+
+nlohmann::json to_json(const ErrorStats& stats) {
+  return {{"count", stats.count},           {"rmse", number_or_null(stats.rmse)},
+          {"mean", number_or_null(stats.mean)}, {"median", number_or_null(stats.median)},
+          {"std", number_or_null(stats.std)},   {"min", number_or_null(stats.min)},
+          {"max", number_or_null(stats.max)}};
+}
+
+nlohmann::json to_json(const TrajectoryReport& report) {
+  const Alignment& alignment = report.alignment;
+  const Vec3& t = alignment.T_gt_est.translation();
+  const Quat& q = alignment.T_gt_est.rotation();
+  nlohmann::json json = {
+      {"gt_poses", report.gt_poses},
+      {"est_poses", report.est_poses},
+      {"matched_poses", report.gt.size()},
+      {"alignment",
+       {{"mode", align_mode_name(alignment.mode)},
+        {"scale", alignment.scale},
+        {"translation", {t.x(), t.y(), t.z()}},
+        {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}}},
+      {"ate", {{"translation_m", to_json(report.ate.translation_m)}, {"rotation_deg", to_json(report.ate.rotation_deg)}}},
+      {"rpe",
+       {{"delta", report.rpe.delta},
+        {"delta_unit", delta_unit_name(report.rpe.unit)},
+        {"translation_m", to_json(report.rpe.translation_m)},
+        {"translation_percent", to_json(report.rpe.translation_percent)},
+        {"rotation_deg", to_json(report.rpe.rotation_deg)}}},
+      {"kitti", nullptr}};
+  if (report.kitti.has_value()) {
+    json["kitti"] = {{"segments", report.kitti->segments},
+                     {"translation_percent", report.kitti->translation_percent},
+                     {"rotation_deg_per_100m", report.kitti->rotation_deg_per_100m}};
+  }
+  return json;
+}
+
+nlohmann::json to_json(const std::vector<ExtrinsicError>& errors) {
+  nlohmann::json lidars = nlohmann::json::array();
+  for (const ExtrinsicError& error : errors) {
+    lidars.push_back({{"name", error.name},
+                      {"rotation_error_deg", error.rotation_error_deg},
+                      {"translation_error_m", error.translation_error_m},
+                      {"nees", error.nees.has_value() ? nlohmann::json(*error.nees) : nlohmann::json()},
+                      {"nees_bound_95", kChiSquare6Dof95},
+                      {"nees_within_95", error.nees.has_value() ? nlohmann::json(error.nees_within_95()) : nlohmann::json()}});
+  }
+  return {{"lidars", lidars}};
+}
+
+nlohmann::json to_json(const MapMetrics& metrics, const MapMetricsOptions& options) {
+  return {{"points", metrics.points},
+          {"points_used", metrics.points_used},
+          {"radius_m", options.radius},
+          {"min_neighbors", options.min_neighbors},
+          {"mean_map_entropy", number_or_null(metrics.mean_map_entropy)},
+          {"mean_plane_variance", number_or_null(metrics.mean_plane_variance)}};
+}
+
+std::string format_table(const TrajectoryReport& report) {
+  std::string text = "poses: " + std::to_string(report.gt.size()) + " matched (gt " + std::to_string(report.gt_poses) +
+                     ", est " + std::to_string(report.est_poses) + "), alignment " +
+                     align_mode_name(report.alignment.mode) + ", scale " + fixed(report.alignment.scale, 6) + "\n";
+  char header[200];
+  std::snprintf(header, sizeof(header), "%-26s %10s %10s %10s %10s\n", "metric", "rmse", "mean", "median", "max");
+  text += header;
+  text += stats_row("ATE trans (m)", report.ate.translation_m);
+  text += stats_row("ATE rot (deg)", report.ate.rotation_deg);
+  char delta[32];
+  std::snprintf(delta, sizeof(delta), "%g", report.rpe.delta);
+  const std::string rpe = std::string("RPE/") + delta + delta_unit_name(report.rpe.unit);
+  text += stats_row((rpe + " trans (m)").c_str(), report.rpe.translation_m);
+  text += stats_row((rpe + " trans (%)").c_str(), report.rpe.translation_percent);
+  text += stats_row((rpe + " rot (deg)").c_str(), report.rpe.rotation_deg);
+  if (report.kitti.has_value()) {
+    text += "KITTI odometry: " + fixed(report.kitti->translation_percent) + " %, " +
+            fixed(report.kitti->rotation_deg_per_100m) + " deg/100m over " + std::to_string(report.kitti->segments) +
+            " segments\n";
+  } else {
+    text += "KITTI odometry: path shorter than 100 m, not computed\n";
+  }
+  return text;
+}
+
+std::string format_table(const std::vector<ExtrinsicError>& errors) {
+  char line[200];
+  std::snprintf(line, sizeof(line), "%-16s %12s %12s %12s\n", "lidar", "rot (deg)", "trans (m)", "NEES (<=12.59)");
+  std::string text = line;
+  for (const ExtrinsicError& error : errors) {
+    const std::string nees = error.nees.has_value()
+                                 ? fixed(*error.nees, 3) + (error.nees_within_95() ? " ok" : " OUT")
+                                 : std::string("-");
+    std::snprintf(line, sizeof(line), "%-16s %12s %12s %12s\n", error.name.c_str(),
+                  fixed(error.rotation_error_deg).c_str(), fixed(error.translation_error_m).c_str(), nees.c_str());
+    text += line;
+  }
+  return text;
+}
+
+std::string format_table(const MapMetrics& metrics, const MapMetricsOptions& options) {
+  return "points: " + std::to_string(metrics.points) + " (" + std::to_string(metrics.points_used) +
+         " with a full-rank neighbourhood, radius " + fixed(options.radius, 3) + " m)\n" +
+         "mean map entropy:    " + fixed(metrics.mean_map_entropy) + "\n" +
+         "mean plane variance: " + fixed(metrics.mean_plane_variance, 8) + " m^2\n";
+}
+
+}  // namespace mlidar::eval
