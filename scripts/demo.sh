@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds Release and runs mlidar's main job on the
-# built-in default. Output goes to ./mlidar_demo (or the folder given).
+# built-in default: a simulated drive of the thesis's four-LiDAR vehicle (rig
+# rv, scene campus, trajectory vehicle, 100 frames, seed 1). Everything goes
+# to ./mlidar_demo (or the folder given as the first argument).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out=${1:-"$PWD/mlidar_demo"}
@@ -11,9 +13,17 @@ cmake --build "$root/build" --parallel "$(nproc)" --target mlidar
 mlidar="$root/build/apps/mlidar/mlidar"
 
 mkdir -p "$out"
-data="$root/../shared/data/real"
-for cloud in "$data/opencalib_3lidar/0001/top.pcd" "$data/opencalib_p64_qt/qt.pcd" "$data/scan_pair/source.ply"; do
-  [[ -f "$cloud" ]] || continue
-  echo "== mlidar info $cloud"
-  "$mlidar" info "$cloud"
+dataset="$out/dataset"
+rm -rf "$dataset"  # the demo's own output from an earlier run
+echo "== simulating the default multi-LiDAR drive into $dataset"
+"$mlidar" simulate drive --rig rv --scene campus --trajectory vehicle --frames 100 --seed 1 --out "$dataset"
+
+echo "== what was written"
+for lidar_dir in "$dataset"/scans/*/; do
+  echo "  $(basename "$lidar_dir"): $(find "$lidar_dir" -name '*.pcd' | wc -l) scans"
 done
+echo "  times.txt: $(wc -l <"$dataset/times.txt") stamps"
+echo "  ground truth: $(ls "$dataset/groundtruth" | tr '\n' ' ')"
+echo "  size: $(du -sh "$dataset" | cut -f1)"
+echo "== first scan of the top LiDAR"
+"$mlidar" info "$dataset/scans/top/000000.pcd"

@@ -12,6 +12,7 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/file_bytes.hpp"
+#include "mlidar/io/text_fields.hpp"
 
 namespace mlidar::io {
 namespace {
@@ -94,7 +95,7 @@ class Checker {
 
 void emit_numbers(YAML::Emitter& out, std::span<const double> values) {
   out << YAML::Flow << YAML::BeginSeq;
-  for (const double v : values) out << v;
+  for (const double v : values) out << exact_number(v);
   out << YAML::EndSeq;
 }
 
@@ -141,7 +142,7 @@ std::string format_dataset_yaml(const Dataset& dataset) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   out << YAML::BeginMap << YAML::Key << "name" << YAML::Value << dataset.name;
-  out << YAML::Key << "frame_period" << YAML::Value << dataset.frame_period;
+  out << YAML::Key << "frame_period" << YAML::Value << exact_number(dataset.frame_period);
   out << YAML::Key << "base" << YAML::Value << dataset.base;
   out << YAML::Key << "times" << YAML::Value << dataset.times.generic_string();
   out << YAML::Key << "lidars" << YAML::Value << YAML::BeginSeq;
@@ -153,9 +154,9 @@ std::string format_dataset_yaml(const Dataset& dataset) {
       out << YAML::Key << "vertical_angles_deg" << YAML::Value;
       emit_numbers(out, lidar.model.vertical_angles_deg);
     }
-    out << YAML::Key << "horizontal_resolution_deg" << YAML::Value << lidar.model.horizontal_resolution_deg;
-    out << YAML::Key << "min_range" << YAML::Value << lidar.model.min_range;
-    out << YAML::Key << "max_range" << YAML::Value << lidar.model.max_range;
+    out << YAML::Key << "horizontal_resolution_deg" << YAML::Value << exact_number(lidar.model.horizontal_resolution_deg);
+    out << YAML::Key << "min_range" << YAML::Value << exact_number(lidar.model.min_range);
+    out << YAML::Key << "max_range" << YAML::Value << exact_number(lidar.model.max_range);
     if (lidar.initial_extrinsic) {
       const SE3& T = *lidar.initial_extrinsic;
       const Vec3& t = T.translation();
