@@ -23,26 +23,6 @@ static_assert(std::endian::native == std::endian::little, "PCD binary data is re
 // block of C compressed bytes decodes to at most 88 * C bytes.
 constexpr std::uint64_t kLzfMaxExpansion = 88;
 
-// Copies one field out of packed records: column[i] = records[i * record_size + offset ...].
-// A compile-time stride lets memcpy become a single load/store.
-template <std::size_t kStride>
-void gather_fixed(const std::byte* records, std::size_t record_size, std::size_t points, std::byte* column) {
-  for (std::size_t i = 0; i < points; ++i) std::memcpy(column + i * kStride, records + i * record_size, kStride);
-}
-
-void gather_field(const std::byte* records, std::size_t record_size, std::size_t points, std::size_t stride,
-                  std::byte* column) {
-  switch (stride) {
-    case 1: return gather_fixed<1>(records, record_size, points, column);
-    case 2: return gather_fixed<2>(records, record_size, points, column);
-    case 4: return gather_fixed<4>(records, record_size, points, column);
-    case 8: return gather_fixed<8>(records, record_size, points, column);
-    case 12: return gather_fixed<12>(records, record_size, points, column);
-    case 16: return gather_fixed<16>(records, record_size, points, column);
-    default:
-      for (std::size_t i = 0; i < points; ++i) std::memcpy(column + i * stride, records + i * record_size, stride);
-  }
-}
 
 void decode_binary_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source,
                         PointTable& table) {
@@ -54,7 +34,8 @@ void decode_binary_body(std::span<const std::byte> body, const PcdHeader& header
   table = pcd_detail::make_table(header);
   std::size_t offset = 0;
   for (FieldColumn& column : table.fields) {
-    gather_field(body.data() + offset, header.record_size, table.num_points, column.stride(), column.data.data());
+    pcd_detail::strided_copy(body.data() + offset, header.record_size, column.data.data(), column.stride(), column.stride(),
+                             table.num_points);
     offset += column.stride();
   }
 }

@@ -93,23 +93,6 @@ std::string format_header(const PcdCloud& cloud, std::uint32_t width, std::uint3
   return out;
 }
 
-template <std::size_t kStride>
-void scatter_fixed(const std::byte* column, std::size_t points, std::size_t record_size, std::byte* records) {
-  for (std::size_t i = 0; i < points; ++i) std::memcpy(records + i * record_size, column + i * kStride, kStride);
-}
-
-// records[i * record_size ...] = column[i]: the inverse of the reader's gather.
-void scatter_field(const std::byte* column, std::size_t points, std::size_t stride, std::size_t record_size,
-                   std::byte* records) {
-  switch (stride) {
-    case 1: return scatter_fixed<1>(column, points, record_size, records);
-    case 2: return scatter_fixed<2>(column, points, record_size, records);
-    case 4: return scatter_fixed<4>(column, points, record_size, records);
-    case 8: return scatter_fixed<8>(column, points, record_size, records);
-    default:
-      for (std::size_t i = 0; i < points; ++i) std::memcpy(records + i * record_size, column + i * stride, stride);
-  }
-}
 
 void append_binary_body(const PointTable& table, std::vector<std::byte>& out) {
   std::size_t record_size = 0;
@@ -118,7 +101,8 @@ void append_binary_body(const PointTable& table, std::vector<std::byte>& out) {
   out.resize(start + table.num_points * record_size);
   std::size_t offset = 0;
   for (const FieldColumn& column : table.fields) {
-    scatter_field(column.data.data(), table.num_points, column.stride(), record_size, out.data() + start + offset);
+    pcd_detail::strided_copy(column.data.data(), column.stride(), out.data() + start + offset, record_size, column.stride(),
+                             table.num_points);
     offset += column.stride();
   }
 }
