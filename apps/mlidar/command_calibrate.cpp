@@ -1,0 +1,142 @@
+// `mlidar calibrate planes`: PS-Calib (thesis Chap. 2) from one scan of each
+// LiDAR looking at a wall corner. `calibrate` is the parent of the solvers.
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/mlidar/commands.hpp"
+#include "apps/mlidar/planes_config_yaml.hpp"
+#include "mlidar/calib/planes_calibrator.hpp"
+#include "mlidar/core/error.hpp"
+#include "mlidar/io/atomic_file.hpp"
+#include "mlidar/io/cloud_file.hpp"
+#include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/file_bytes.hpp"
+
+namespace mlidar::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct PlanesOptions {
+  std::string ref;
+  std::string target;
+  std::string init;
+  std::string config;
+  std::string out;
+  std::string report;
+  bool strict = false;
+};
+
+std::string lidar_name(const std::string& path, const std::string& fallback) {
+  const std::string stem = fs::path(path).stem().string();
+  return stem.empty() ? fallback : stem;
+}
+
+/// T_ref_target from an extrinsics file that names both LiDARs (or whose base is the reference).
+SE3 read_guess(const std::string& path, const std::string& ref_name, const std::string& target_name) {
+  const io::Extrinsics extrinsics = io::read_extrinsics(path);
+  const io::LidarExtrinsic* target = extrinsics.find(target_name);
+  if (target == nullptr) throw InputError(path, "lidars." + target_name, "missing; --init must name the target LiDAR");
+  const io::LidarExtrinsic* ref = extrinsics.find(ref_name);
+  if (ref == nullptr && extrinsics.base != ref_name)
+    throw InputError(path, "lidars." + ref_name, "missing; --init must name the reference LiDAR or use it as base");
+  return ref == nullptr ? target->T_base_lidar : ref->T_base_lidar.inverse() * target->T_base_lidar;
+}
+
+nlohmann::json pose_json(const SE3& T) {
+  const Quat& q = T.rotation();
+  return {{"translation", {T.translation().x(), T.translation().y(), T.translation().z()}},
+          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+nlohmann::json cloud_json(const calib::CloudCornerReport& cloud) {
+  nlohmann::json planes = nlohmann::json::array();
+  const char* names[3] = {"left", "right", "bottom"};
+  for (int i = 0; i < 3; ++i) {
+    const auto& p = cloud.planes[i];
+    planes.push_back({{"name", names[i]},
+                      {"normal", {p.plane.normal.x(), p.plane.normal.y(), p.plane.normal.z()}},
+                      {"offset", p.plane.offset},
+                      {"inliers", p.inliers},
+                      {"residual_rms_m", p.residual_rms}});
+  }
+  return {{"planes_found", cloud.planes_found},
+          {"planes", planes},
+          {"angles_deg", {cloud.angles_deg[0], cloud.angles_deg[1], cloud.angles_deg[2]}},
+          {"corner", {cloud.corner.x(), cloud.corner.y(), cloud.corner.z()}}};
+}
+
+nlohmann::json report_json(const calib::PlanesResult& result, double seconds) {
+  nlohmann::json warnings = nlohmann::json::array();
+  for (const auto w : result.warnings) warnings.push_back(calib::warning_name(w));
+  std::vector<double> covariance(result.covariance.data(), result.covariance.data() + 36);  // symmetric
+  return {{"verdict", result.ok() ? "ok" : "warning"},
+          {"warnings", warnings},
+          {"T_ref_target", pose_json(result.T_ref_target)},
+          {"T_ref_target_closed_form", pose_json(result.T_ref_target_closed_form)},
+          {"covariance", covariance},
+          {"residual_sigma_m", result.residual_sigma},
+          {"rotation_sigma_max_deg", result.rotation_sigma_max_deg},
+          {"iterations", result.iterations},
+          {"converged", result.converged},
+          {"seconds", seconds},
+          {"ref", cloud_json(result.ref)},
+          {"target", cloud_json(result.target)}};
+}
+
+int run_planes(const PlanesOptions& options) {
+  const std::string ref_name = lidar_name(options.ref, "ref");
+  std::string target_name = lidar_name(options.target, "target");
+  if (target_name == ref_name) target_name = "target";
+  calib::PlanesConfig config;
+  if (!options.config.empty()) config = parse_planes_config(io::read_file_text(options.config), options.config);
+  const calib::PlanesCalibrator calibrator(config);
+  std::optional<SE3> guess;
+  if (!options.init.empty()) guess = read_guess(options.init, ref_name, target_name);
+  const Scan ref = io::to_scan(io::read_cloud(options.ref).table, options.ref);
+  const Scan target = io::to_scan(io::read_cloud(options.target).table, options.target);
+
+  const auto start = std::chrono::steady_clock::now();
+  const calib::PlanesResult result = calibrator.calibrate(ref.points, target.points, guess, options.ref, options.target);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  io::Extrinsics extrinsics;
+  extrinsics.base = ref_name;
+  extrinsics.lidars = {{ref_name, SE3(), std::nullopt}, {target_name, result.T_ref_target, result.covariance}};
+  io::write_extrinsics(options.out, extrinsics);
+  if (!options.report.empty()) {
+    const std::string text = report_json(result, seconds).dump(2);
+    io::write_atomically(options.report, [&](std::ostream& out) { out << text << '\n'; });
+  }
+  const Vec3& t = result.T_ref_target.translation();
+  std::cout << "T_ref_target t = [" << t.x() << ", " << t.y() << ", " << t.z() << "] m, residual sigma "
+            << result.residual_sigma << " m, " << result.iterations << " iterations, " << seconds << " s\n";
+  std::cout << "verdict: " << (result.ok() ? "ok" : "warning");
+  for (const auto w : result.warnings) std::cout << ' ' << calib::warning_name(w);
+  std::cout << '\n';
+  return options.strict && !result.ok() ? static_cast<int>(ExitCode::kUntrusted) : 0;
+}
+
+}  // namespace
+
+Command register_calibrate(CLI::App& app) {
+  CLI::App* sub = app.add_subcommand("calibrate", "Calibrate LiDAR extrinsics");
+  sub->require_subcommand(1);
+  auto planes = std::make_shared<PlanesOptions>();
+  CLI::App* planes_cmd = sub->add_subcommand("planes", "One-shot calibration from a wall corner seen by two LiDARs");
+  planes_cmd->add_option("--ref", planes->ref, "Reference LiDAR cloud (PCD, PLY, KITTI .bin)")->required();
+  planes_cmd->add_option("--target", planes->target, "Target LiDAR cloud")->required();
+  planes_cmd->add_option("--init", planes->init, "Rough extrinsics YAML naming both LiDARs (picks the plane matching)");
+  planes_cmd->add_option("--config", planes->config, "planes.yaml with PlanesConfig keys");
+  planes_cmd->add_option("--out", planes->out, "Output extrinsics YAML (T_ref_target with covariance)")->required();
+  planes_cmd->add_option("--report", planes->report, "JSON report: planes, angles, residuals, verdict");
+  planes_cmd->add_flag("--strict", planes->strict, "Exit 1 when the verdict carries a warning");
+  return {sub, [planes] { return run_planes(*planes); }};
+}
+
+}  // namespace mlidar::cli

@@ -1,0 +1,43 @@
+#include "mlidar/calib/planes_types.hpp"
+
+#include <string>
+
+#include "mlidar/core/error.hpp"
+
+namespace mlidar::calib {
+namespace {
+
+void require(bool holds, const char* key, const std::string& expected) {
+  if (!holds) throw UsageError(std::string("planes config: ") + key + ": expected " + expected);
+}
+
+}  // namespace
+
+void PlanesConfig::validate() const {
+  require(inlier_distance > 0.0 && inlier_distance < 10.0, "inlier_distance", "0 < metres < 10");
+  require(ransac_iterations >= 1 && ransac_iterations <= 1000000, "ransac_iterations", "1 to 1000000");
+  require(max_planes >= 3 && max_planes <= 20, "max_planes", "3 to 20");
+  require(min_plane_points >= 3, "min_plane_points", "at least 3");
+  require(min_corner_angle_deg > 0.0 && min_corner_angle_deg <= 90.0, "min_corner_angle_deg", "0 < degrees <= 90");
+  require(min_any_angle_deg > 0.0 && min_any_angle_deg <= min_corner_angle_deg, "min_any_angle_deg",
+          "0 < degrees <= min_corner_angle_deg");
+  require(corner_max_gap > 0.0, "corner_max_gap", "metres > 0");
+  require(max_points_per_plane >= 10, "max_points_per_plane", "at least 10");
+  require(huber_delta > 0.0, "huber_delta", "metres > 0");
+  require(max_iterations >= 1, "max_iterations", "at least 1");
+  require(max_rotation_sigma_deg > 0.0, "max_rotation_sigma_deg", "degrees > 0");
+  require(up.allFinite() && up.norm() > 0.5, "up", "a finite vector of length about 1");
+}
+
+const char* warning_name(PlanesWarning warning) {
+  switch (warning) {
+    case PlanesWarning::kPlanesNearlyParallel: return "planes_nearly_parallel";
+    case PlanesWarning::kFewInliers: return "few_inliers";
+    case PlanesWarning::kCornerOutsideClouds: return "corner_outside_clouds";
+    case PlanesWarning::kRotationPoorlyConditioned: return "rotation_poorly_conditioned";
+    case PlanesWarning::kNotConverged: return "not_converged";
+  }
+  return "unknown";
+}
+
+}  // namespace mlidar::calib
