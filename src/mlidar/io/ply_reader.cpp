@@ -11,6 +11,7 @@
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/io/ply.hpp"
 #include "mlidar/io/ply_header.hpp"
+#include "mlidar/io/text_fields.hpp"
 
 namespace mlidar::io {
 namespace {
@@ -105,31 +106,6 @@ class BinaryBody {
   const std::string& source_;
 };
 
-template <typename T>
-bool parse_as(std::string_view token, std::byte* out) {
-  T value{};
-  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (ec != std::errc() || end != token.data() + token.size()) return false;
-  std::memcpy(out, &value, sizeof(T));
-  return true;
-}
-
-bool parse_ascii_scalar(std::string_view token, ScalarType type, std::byte* out) {
-  switch (type) {
-    case ScalarType::kI8: return parse_as<std::int8_t>(token, out);
-    case ScalarType::kU8: return parse_as<std::uint8_t>(token, out);
-    case ScalarType::kI16: return parse_as<std::int16_t>(token, out);
-    case ScalarType::kU16: return parse_as<std::uint16_t>(token, out);
-    case ScalarType::kI32: return parse_as<std::int32_t>(token, out);
-    case ScalarType::kU32: return parse_as<std::uint32_t>(token, out);
-    case ScalarType::kI64: return parse_as<std::int64_t>(token, out);
-    case ScalarType::kU64: return parse_as<std::uint64_t>(token, out);
-    case ScalarType::kF32: return parse_as<float>(token, out);
-    case ScalarType::kF64: return parse_as<double>(token, out);
-  }
-  return false;
-}
-
 // Values are whitespace-separated tokens; line breaks carry no meaning.
 class AsciiBody {
  public:
@@ -146,7 +122,7 @@ class AsciiBody {
     while (pos_ < text_.size() && !is_blank(text_[pos_])) ++pos_;
     if (pos_ == start) throw InputError(source_, where.str(), "data ends early (fewer values than the header promises)");
     const std::string_view token = text_.substr(start, pos_ - start);
-    if (!parse_ascii_scalar(token, type, out)) {
+    if (!parse_scalar_token(token, type, out)) {
       throw InputError(source_, where.str(), "'" + std::string(token.substr(0, 40)) + "' is not a valid " + scalar_name(type));
     }
   }

@@ -3,7 +3,10 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <system_error>
+#include <type_traits>
 
 #include "mlidar/core/error.hpp"
 
@@ -95,6 +98,55 @@ std::string exact_number(double value) {
   std::array<char, 64> buffer{};
   const auto [end, ec] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
   return ec == std::errc() ? std::string(buffer.data(), end) : std::string("nan");
+}
+
+namespace {
+
+template <typename T>
+bool parse_exact(std::string_view word, T& value) {
+  const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+  return ec == std::errc{} && end == word.data() + word.size();
+}
+
+// Floats too small for float32 round to zero or a subnormal instead of failing.
+bool parse_float(std::string_view word, float& value) {
+  if (parse_exact(word, value)) return true;
+  double wide = 0.0;
+  if (!parse_exact(word, wide) || std::abs(wide) >= std::numeric_limits<float>::min()) return false;
+  value = static_cast<float>(wide);
+  return true;
+}
+
+template <typename T>
+bool parse_into(std::string_view word, std::byte* out) {
+  if (word.size() > 1 && word[0] == '+' && word[1] != '-') word.remove_prefix(1);
+  T value{};
+  bool ok = false;
+  if constexpr (std::is_same_v<T, float>) {
+    ok = parse_float(word, value);
+  } else {
+    ok = parse_exact(word, value);
+  }
+  if (ok) std::memcpy(out, &value, sizeof(T));
+  return ok;
+}
+
+}  // namespace
+
+bool parse_scalar_token(std::string_view word, ScalarType type, std::byte* out) {
+  switch (type) {
+    case ScalarType::kI8: return parse_into<std::int8_t>(word, out);
+    case ScalarType::kU8: return parse_into<std::uint8_t>(word, out);
+    case ScalarType::kI16: return parse_into<std::int16_t>(word, out);
+    case ScalarType::kU16: return parse_into<std::uint16_t>(word, out);
+    case ScalarType::kI32: return parse_into<std::int32_t>(word, out);
+    case ScalarType::kU32: return parse_into<std::uint32_t>(word, out);
+    case ScalarType::kI64: return parse_into<std::int64_t>(word, out);
+    case ScalarType::kU64: return parse_into<std::uint64_t>(word, out);
+    case ScalarType::kF32: return parse_into<float>(word, out);
+    case ScalarType::kF64: return parse_into<double>(word, out);
+  }
+  return false;
 }
 
 }  // namespace mlidar::io

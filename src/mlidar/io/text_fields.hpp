@@ -1,11 +1,13 @@
 #pragma once
-// Small helpers shared by the text formats (KITTI, TUM, OpenCalib): lines with
+// Small helpers shared by the text formats (KITTI, TUM, OpenCalib, ascii PCD/PLY): lines with
 // their numbers, whitespace tokens, strict number parsing with errors that
 // name the file and the line, and exact (shortest round-trip) number printing.
 #include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "mlidar/io/point_table.hpp"
 
 namespace mlidar::io {
 
@@ -27,6 +29,12 @@ double parse_double(std::string_view token, const std::string& source, const std
 double parse_finite(std::string_view token, const std::string& source, const std::string& field);
 /// Parses the whole token as a base-10 integer.
 long long parse_integer(std::string_view token, const std::string& source, const std::string& field);
+
+/// Parses the whole token as one scalar of `type` into `out` (scalar_size(type)
+/// bytes, host order). Integers must be exact and fit the type; floats accept
+/// nan and inf, and float32 values below its range become 0 or a subnormal.
+/// A leading '+' is accepted. Returns false (writing nothing) otherwise.
+bool parse_scalar_token(std::string_view token, ScalarType type, std::byte* out);
 
 /// "line N" for error messages.
 std::string line_field(std::size_t number);
