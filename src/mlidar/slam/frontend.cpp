@@ -24,10 +24,10 @@ class StageTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
-/// Times shifted to the frame stamp (scan.time counts from scan.stamp), in a reused buffer.
-std::span<const float> times_from_frame_stamp(const Scan& scan, double frame_stamp, std::vector<float>& buffer) {
+/// Times shifted to the reference stamp (scan.time counts from scan.stamp), in a reused buffer.
+std::span<const float> times_from_reference(const Scan& scan, double reference_stamp, std::vector<float>& buffer) {
   if (!scan.has_time()) return {};
-  const float shift = static_cast<float>(scan.stamp - frame_stamp);
+  const float shift = static_cast<float>(scan.stamp - reference_stamp);
   if (shift == 0.0F) return scan.time;
   buffer.resize(scan.time.size());
   std::transform(scan.time.begin(), scan.time.end(), buffer.begin(), [shift](float t) { return t + shift; });
@@ -35,9 +35,12 @@ std::span<const float> times_from_frame_stamp(const Scan& scan, double frame_sta
 }
 
 void deskew_selection(const Scan& scan, std::span<const float> times, std::span<const std::uint32_t> indices, const LidarSetup& lidar,
-                      const BodyVelocity& velocity, std::vector<Eigen::Vector3f>& out) {
+                      const BodyVelocity& velocity, std::vector<Eigen::Vector3f>& out, std::vector<float>& out_times) {
   out.resize(indices.size());
   if (!indices.empty()) deskew_to_base(scan.points, times, indices, lidar.T_base_lidar, velocity, out);
+  out_times.clear();
+  if (!times.empty())
+    for (const std::uint32_t i : indices) out_times.push_back(times[i]);
 }
 
 }  // namespace
@@ -68,10 +71,10 @@ std::vector<std::uint32_t> voxel_subsample(std::span<const Eigen::Vector3f> poin
   return kept;
 }
 
-void run_front_end(const Scan& scan, double frame_stamp, const LidarSetup& lidar, const BodyVelocity& velocity,
+void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& lidar, const BodyVelocity& velocity,
                    const FrontEndConfig& config, FrontEndWorkspace& ws, LidarFeatures& out, StageSeconds& seconds) {
   std::vector<float> shifted;
-  const std::span<const float> times = times_from_frame_stamp(scan, frame_stamp, shifted);
+  const std::span<const float> times = times_from_reference(scan, reference_stamp, shifted);
   if (lidar.model.vertical_angles_deg.empty()) {
     std::vector<std::uint32_t> kept;
     {
@@ -80,7 +83,8 @@ void run_front_end(const Scan& scan, double frame_stamp, const LidarSetup& lidar
     }
     StageTimer timer(seconds, Stage::kDeskew);
     out.edges.clear();
-    deskew_selection(scan, times, kept, lidar, velocity, out.planes);
+    out.edge_times.clear();
+    deskew_selection(scan, times, kept, lidar, velocity, out.planes, out.plane_times);
     return;
   }
   {
@@ -99,8 +103,8 @@ void run_front_end(const Scan& scan, double frame_stamp, const LidarSetup& lidar
     extract_features(ws.image, ws.segmentation, config.features, ws.features, ws.indices);
   }
   StageTimer timer(seconds, Stage::kDeskew);
-  deskew_selection(scan, times, ws.indices.edges, lidar, velocity, out.edges);
-  deskew_selection(scan, times, ws.indices.planes, lidar, velocity, out.planes);
+  deskew_selection(scan, times, ws.indices.edges, lidar, velocity, out.edges, out.edge_times);
+  deskew_selection(scan, times, ws.indices.planes, lidar, velocity, out.planes, out.plane_times);
 }
 
 }  // namespace mlidar::slam

@@ -36,10 +36,15 @@ struct LidarSetup {
   SE3 T_base_lidar;
 };
 
-/// Features of one LiDAR in the base frame at the frame stamp.
+/// Features of one LiDAR in the base frame at the reference stamp given to run_front_end.
 struct LidarFeatures {
   std::vector<Eigen::Vector3f> edges;
   std::vector<Eigen::Vector3f> planes;
+  /// Capture times (seconds from the reference stamp) of each edge / plane;
+  /// empty when the scan has no times. They let a later, better velocity
+  /// deskew the features again.
+  std::vector<float> edge_times;
+  std::vector<float> plane_times;
 };
 
 /// Buffers reused across frames (one per LiDAR, so LiDARs can run in parallel).
@@ -51,9 +56,10 @@ struct FrontEndWorkspace {
   std::vector<double> sorted_angles_deg;
 };
 
-/// Runs the front end; `velocity` deskews each point by its time (scan.time,
-/// seconds from the frame stamp `frame_stamp`, shifted by scan.stamp - frame_stamp).
-void run_front_end(const Scan& scan, double frame_stamp, const LidarSetup& lidar, const BodyVelocity& velocity,
+/// Runs the front end; `velocity` deskews each point to the base at
+/// `reference_stamp` by its time from it (scan.time counts from scan.stamp,
+/// so the shift is scan.stamp - reference_stamp).
+void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& lidar, const BodyVelocity& velocity,
                    const FrontEndConfig& config, FrontEndWorkspace& workspace, LidarFeatures& out, StageSeconds& seconds);
 
 /// Indices of the first point in each voxel of size voxel_m (finite points only).

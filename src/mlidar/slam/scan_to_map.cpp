@@ -13,8 +13,6 @@ namespace {
 struct NormalEquations {
   Mat6 H = Mat6::Zero();
   Vec6 g = Vec6::Zero();
-  Mat3 H_translation = Mat3::Zero();  ///< sum w J_t^T J_t (unit-free: normals' spread)
-  double weight = 0.0;
   double residual_sum = 0.0;
   std::size_t planes = 0;
   std::size_t edges = 0;
@@ -23,13 +21,11 @@ struct NormalEquations {
   void add(const Eigen::Matrix<double, Rows, 1>& r, const Eigen::Matrix<double, Rows, 6>& J, double w) {
     H.noalias() += w * J.transpose() * J;
     g.noalias() += w * J.transpose() * r;
-    H_translation.noalias() += w * J.template leftCols<3>().transpose() * J.template leftCols<3>();
-    weight += w;
     residual_sum += r.norm();
   }
   NormalEquations& operator+=(const NormalEquations& o) {
-    H += o.H; g += o.g; H_translation += o.H_translation;
-    weight += o.weight; residual_sum += o.residual_sum; planes += o.planes; edges += o.edges;
+    H += o.H; g += o.g;
+    residual_sum += o.residual_sum; planes += o.planes; edges += o.edges;
     return *this;
   }
 };
@@ -58,13 +54,14 @@ struct Matcher {
   const VoxelMap& plane_map;
   const SE3& T;
   const RegistrationConfig& config;
-  float max_distance_sq;
+  float neighborhood_sq;    ///< squared search radius for the map neighbours
+  double max_residual_m;    ///< correspondences with a larger |r| are rejected
   double huber_delta;
 
   void plane(const Eigen::Vector3f& p, NormalEquations& eq) const {
     std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
     const Vec3 q = T * Vec3(p.cast<double>());
-    const int count = plane_map.nearest(q.cast<float>(), config.neighbors, max_distance_sq, near);
+    const int count = plane_map.nearest(q.cast<float>(), config.neighbors, neighborhood_sq, near);
     Neighbourhood hood;
     if (count < 3 || !fit(near, count, hood)) return;
     // Colinear neighbours (one scan line) leave the normal's direction free about the line.
@@ -75,6 +72,7 @@ struct Matcher {
     Vec3 r;
     Mat36 J;
     plane_residual(plane, q, r, J);
+    if (r.norm() > max_residual_m) return;
     eq.add(r, J, huber_weight(r.norm(), huber_delta));
     ++eq.planes;
   }
@@ -82,7 +80,7 @@ struct Matcher {
   void edge(const Eigen::Vector3f& p, NormalEquations& eq) const {
     std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
     const Vec3 q = T * Vec3(p.cast<double>());
-    const int count = edge_map.nearest(q.cast<float>(), config.neighbors, max_distance_sq, near);
+    const int count = edge_map.nearest(q.cast<float>(), config.neighbors, neighborhood_sq, near);
     Neighbourhood hood;
     if (count < 3 || !fit(near, count, hood)) return;
     const Vec3 values = hood.eigen.eigenvalues();
@@ -103,6 +101,7 @@ struct Matcher {
     plane_residual(planes.second, q, r1, J1);
     r.tail<3>() = r1;
     J.bottomRows<3>() = J1;
+    if (r.norm() > max_residual_m) return;
     eq.add(r, J, huber_weight(r.norm(), huber_delta));
     ++eq.edges;
   }
@@ -125,6 +124,22 @@ NormalEquations linearise(std::span<const Eigen::Vector3f> edges, std::span<cons
       [](NormalEquations a, const NormalEquations& b) { return a += b; });
 }
 
+/// Degeneracy at the solution. Early iterations, far from it, may match mostly
+/// one surface (the ground), so this is judged once, at the end: the
+/// correction from `initial` loses its translation along the weak direction.
+void keep_initial_along_weak_translation(const SE3& initial, double threshold, RegistrationResult& result) {
+  // Translation block of H: sum w J_t^T J_t = sum w n n^T over the residual normals.
+  const Eigen::SelfAdjointEigenSolver<Mat3> translation(result.hessian.topLeftCorner<3, 3>());
+  const Vec3 spread = translation.eigenvalues();
+  result.translation_observability = spread(2) > 0.0 ? spread(0) / spread(2) : 0.0;
+  result.degenerate = result.translation_observability < threshold;
+  if (!result.degenerate) return;
+  Vec6 correction = (result.T_world_base * initial.inverse()).log();
+  const Vec3 weak = translation.eigenvectors().col(0);
+  correction.head<3>() -= weak * weak.dot(correction.head<3>());
+  result.T_world_base = SE3::exp(correction) * initial;
+}
+
 }  // namespace
 
 RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_base, std::span<const Eigen::Vector3f> planes_base,
@@ -133,9 +148,10 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_b
   RegistrationResult result;
   result.T_world_base = initial;
   result.queries = edges_base.size() + planes_base.size();
-  const float max_distance_sq = static_cast<float>(max_correspondence_m * max_correspondence_m);
+  const double radius = std::max(max_correspondence_m, config.neighborhood_radius_m);
+  const auto neighborhood_sq = static_cast<float>(radius * radius);
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    const Matcher matcher{edge_map, plane_map, result.T_world_base, config, max_distance_sq, config.huber_delta_m};
+    const Matcher matcher{edge_map, plane_map, result.T_world_base, config, neighborhood_sq, max_correspondence_m, config.huber_delta_m};
     const NormalEquations eq = linearise(edges_base, planes_base, matcher);
     result.iterations = iteration + 1;
     result.plane_matches = eq.planes;
@@ -143,14 +159,7 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_b
     result.hessian = eq.H;
     if (eq.planes + eq.edges < 6) return result;
     result.mean_residual_m = eq.residual_sum / static_cast<double>(eq.planes + eq.edges);
-    Vec6 delta = eq.H.ldlt().solve(-eq.g);
-    const Eigen::SelfAdjointEigenSolver<Mat3> translation(eq.H_translation / eq.weight);
-    result.translation_observability = translation.eigenvalues()(0);
-    result.degenerate = result.translation_observability < config.degeneracy_threshold;
-    if (result.degenerate) {
-      const Vec3 weak = translation.eigenvectors().col(0);
-      delta.head<3>() -= weak * weak.dot(delta.head<3>());
-    }
+    const Vec6 delta = eq.H.ldlt().solve(-eq.g);
     if (!delta.allFinite()) return result;
     result.T_world_base = SE3::exp(delta) * result.T_world_base;
     if (delta.head<3>().norm() < config.convergence_translation_m && delta.tail<3>().norm() < config.convergence_rotation_rad) {
@@ -159,6 +168,7 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_b
     }
   }
   result.eigenvalues = Eigen::SelfAdjointEigenSolver<Mat6>(result.hessian).eigenvalues();
+  keep_initial_along_weak_translation(initial, config.degeneracy_threshold, result);
   return result;
 }
 
