@@ -1,0 +1,45 @@
+#pragma once
+// `mlidar odometry`: runs slam::Odometry over a dataset folder (io/dataset.hpp,
+// all or some LiDARs with their initial extrinsics and models) or over a
+// folder of single-LiDAR clouds (natural file order, stamps k * period), and
+// writes the run folder, every file atomically:
+//   trajectory.tum    T_world_base at each frame stamp
+//   trajectory.kitti  the same poses, KITTI 3x4 rows
+//   map.ply           the local plane and edge maps (voxel-downsampled)
+//   metrics.json      per-stage seconds per frame (mean/p50/p95/max), points
+//                     in/out, smallest eigenvalues and observability per
+//                     frame, degenerate, retried and lost frame counts
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mlidar/core/types.hpp"
+
+namespace mlidar::pipelines {
+
+struct OdometryJob {
+  std::filesystem::path dataset;          ///< a dataset folder, or empty
+  std::filesystem::path scans;            ///< a folder of clouds, or empty
+  double period = 0.1;                    ///< seconds between clouds of `scans`
+  std::vector<std::string> lidars;        ///< dataset LiDARs to use; empty = all
+  int threads = 0;                        ///< 0 = TBB's default
+  std::filesystem::path out;
+};
+
+struct OdometryJobSummary {
+  std::size_t frames = 0;
+  std::size_t degenerate_frames = 0;
+  std::size_t lost_frames = 0;
+  double mean_frame_seconds = 0.0;
+  Trajectory trajectory;
+};
+
+/// Files sorted in natural order: digit runs compare as numbers ("full20" < "full100").
+std::vector<std::filesystem::path> natural_sorted_clouds(const std::filesystem::path& folder);
+bool natural_less(const std::string& a, const std::string& b);
+
+/// UsageError for a bad combination of options; InputError for bad files.
+OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<void(int, int)>& progress = {});
+
+}  // namespace mlidar::pipelines

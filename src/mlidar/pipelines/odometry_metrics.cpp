@@ -1,0 +1,69 @@
+#include "mlidar/pipelines/odometry_metrics.hpp"
+
+#include <algorithm>
+
+#include "mlidar/io/cloud_file.hpp"
+
+namespace mlidar::pipelines {
+namespace {
+
+nlohmann::json summary_of(std::vector<double> values) {
+  if (values.empty()) return {{"mean", 0.0}, {"p50", 0.0}, {"p95", 0.0}, {"max", 0.0}};
+  std::sort(values.begin(), values.end());
+  double sum = 0.0;
+  for (const double v : values) sum += v;
+  const auto at = [&](double q) { return values[static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5)]; };
+  return {{"mean", sum / static_cast<double>(values.size())}, {"p50", at(0.5)}, {"p95", at(0.95)}, {"max", values.back()}};
+}
+
+}  // namespace
+
+nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars) {
+  nlohmann::json json;
+  json["frames"] = frames.size();
+  for (const auto& lidar : lidars) json["lidars"].push_back(lidar.name);
+  std::vector<double> total, points_in, features_out;
+  std::size_t degenerate = 0, retried = 0, lost = 0;
+  for (std::size_t s = 0; s < slam::kStageCount; ++s) {
+    std::vector<double> stage;
+    for (const auto& f : frames) stage.push_back(f.seconds[s]);
+    json["stages"][slam::stage_name(static_cast<slam::Stage>(s))] = summary_of(stage);
+  }
+  nlohmann::json per_frame = nlohmann::json::array();
+  for (const auto& f : frames) {
+    double sum = 0.0;
+    for (const double v : f.seconds) sum += v;
+    total.push_back(sum);
+    points_in.push_back(static_cast<double>(f.points_in));
+    features_out.push_back(static_cast<double>(f.edge_features + f.plane_features));
+    degenerate += f.registration.degenerate ? 1 : 0;
+    retried += f.retried ? 1 : 0;
+    lost += f.lost ? 1 : 0;
+    const auto& r = f.registration;
+    per_frame.push_back({{"stamp", f.stamp}, {"eigenvalues", std::vector<double>(r.eigenvalues.data(), r.eigenvalues.data() + 6)},
+                         {"translation_observability", r.translation_observability}, {"degenerate", r.degenerate},
+                         {"lost", f.lost}, {"retried", f.retried}, {"iterations", r.iterations}, {"match_ratio", r.match_ratio()},
+                         {"threshold_m", f.threshold_m}, {"edges", f.edge_features}, {"planes", f.plane_features}});
+  }
+  json["total_seconds"] = summary_of(total);
+  json["points_in"] = summary_of(points_in);
+  json["features_out"] = summary_of(features_out);
+  json["degenerate_frames"] = degenerate;
+  json["retried_frames"] = retried;
+  json["lost_frames"] = lost;
+  json["per_frame"] = std::move(per_frame);
+  return json;
+}
+
+void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry) {
+  Scan map;
+  map.points = odometry.plane_map().points();
+  const auto edges = odometry.edge_map().points();
+  map.points.insert(map.points.end(), edges.begin(), edges.end());
+  io::CloudFile cloud;
+  cloud.format = io::CloudFormat::kPly;
+  cloud.table = io::from_scan(map);
+  io::write_cloud(path, cloud);
+}
+
+}  // namespace mlidar::pipelines

@@ -1,0 +1,20 @@
+#pragma once
+// metrics.json and map.ply of an odometry run (see odometry_job.hpp).
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mlidar/slam/odometry.hpp"
+
+namespace mlidar::pipelines {
+
+/// {"frames", "lidars", "stages": {NAME: {mean, p50, p95, max} seconds per frame},
+///  "total_seconds": {...}, "points_in", "features_out", "degenerate_frames", "retried_frames",
+///  "lost_frames", "per_frame": [{stamp, eigenvalues, translation_observability, degenerate, lost, ...}]}
+nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars);
+
+/// The odometry's local maps (planes then edges) as a binary PLY, atomically.
+void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry);
+
+}  // namespace mlidar::pipelines

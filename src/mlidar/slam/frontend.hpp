@@ -1,0 +1,68 @@
+#pragma once
+// Per-LiDAR front end: range image -> segmentation -> features -> deskew into
+// the base frame at the frame stamp. A LiDAR without a vertical angle table
+// (a folder of plain clouds) falls back to a voxel subsample whose points all
+// serve as plane queries (the matcher checks planarity in the map).
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mlidar/core/types.hpp"
+#include "mlidar/slam/deskew.hpp"
+#include "mlidar/slam/features.hpp"
+#include "mlidar/slam/range_image.hpp"
+#include "mlidar/slam/segmentation.hpp"
+
+namespace mlidar::slam {
+
+enum class Stage : std::uint8_t { kRangeImage, kSegmentation, kFeatures, kDeskew, kRegistration, kMapUpdate };
+inline constexpr std::size_t kStageCount = 6;
+const char* stage_name(Stage stage);  ///< "range_image", ...
+
+/// Seconds spent per stage (summed over LiDARs when they run one after another).
+using StageSeconds = std::array<double, kStageCount>;
+
+struct FrontEndConfig {
+  SegmentationConfig segmentation;
+  FeatureConfig features;
+  double fallback_voxel_m = 0.5;  ///< subsample size for LiDARs without a model
+};
+
+/// One LiDAR as the odometry sees it.
+struct LidarSetup {
+  std::string name;
+  LidarModel model;         ///< vertical_angles_deg may be empty (fallback)
+  SE3 T_base_lidar;
+};
+
+/// Features of one LiDAR in the base frame at the reference stamp given to run_front_end.
+struct LidarFeatures {
+  std::vector<Eigen::Vector3f> edges;
+  std::vector<Eigen::Vector3f> planes;
+  /// Capture times (seconds from the reference stamp) of each edge / plane;
+  /// empty when the scan has no times. They let a later, better velocity
+  /// deskew the features again.
+  std::vector<float> edge_times;
+  std::vector<float> plane_times;
+};
+
+/// Buffers reused across frames (one per LiDAR, so LiDARs can run in parallel).
+struct FrontEndWorkspace {
+  RangeImage image;
+  Segmentation segmentation;
+  FeatureWorkspace features;
+  FeatureIndices indices;
+  std::vector<double> sorted_angles_deg;
+};
+
+/// Runs the front end; `velocity` deskews each point to the base at
+/// `reference_stamp` by its time from it (scan.time counts from scan.stamp,
+/// so the shift is scan.stamp - reference_stamp).
+void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& lidar, const BodyVelocity& velocity,
+                   const FrontEndConfig& config, FrontEndWorkspace& workspace, LidarFeatures& out, StageSeconds& seconds);
+
+/// Indices of the first point in each voxel of size voxel_m (finite points only).
+std::vector<std::uint32_t> voxel_subsample(std::span<const Eigen::Vector3f> points, double voxel_m);
+
+}  // namespace mlidar::slam

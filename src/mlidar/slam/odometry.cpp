@@ -1,0 +1,187 @@
+#include "mlidar/slam/odometry.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include <tbb/parallel_for.h>
+
+namespace mlidar::slam {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void append_transformed(const SE3& T, std::span<const Eigen::Vector3f> points, std::vector<Eigen::Vector3f>& out) {
+  const std::size_t begin = out.size();
+  out.resize(begin + points.size());
+  transform_points(T, points, std::span(out).subspan(begin));
+}
+
+/// Mean capture time of the frame's points in seconds after its stamp (0 without times).
+double mean_point_time(const Frame& frame) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (const Scan& scan : frame.scans) {
+    if (!scan.has_time()) continue;
+    const double shift = scan.stamp - frame.stamp;
+    for (const float t : scan.time) sum += static_cast<double>(t) + shift;
+    count += scan.time.size();
+  }
+  return count == 0 ? 0.0 : sum / static_cast<double>(count);
+}
+
+/// Appends one LiDAR's features; a LiDAR without times gets time 0 (no motion) so times stay aligned with points.
+void append_features(const LidarFeatures& from, LidarFeatures& to) {
+  to.edges.insert(to.edges.end(), from.edges.begin(), from.edges.end());
+  to.planes.insert(to.planes.end(), from.planes.begin(), from.planes.end());
+  if (from.edge_times.empty()) to.edge_times.resize(to.edges.size(), 0.0F);
+  else to.edge_times.insert(to.edge_times.end(), from.edge_times.begin(), from.edge_times.end());
+  if (from.plane_times.empty()) to.plane_times.resize(to.planes.size(), 0.0F);
+  else to.plane_times.insert(to.plane_times.end(), from.plane_times.begin(), from.plane_times.end());
+}
+
+void clear_features(LidarFeatures& f) {
+  f.edges.clear();
+  f.planes.clear();
+  f.edge_times.clear();
+  f.plane_times.clear();
+}
+
+/// Features deskewed (to the base at their reference stamp) with no motion, deskewed again with `velocity`.
+void deskew_again(const BodyVelocity& velocity, LidarFeatures& f) {
+  const std::vector<Eigen::Vector3f> edges = f.edges, planes = f.planes;
+  deskew_to_base(edges, f.edge_times, {}, SE3::identity(), velocity, f.edges);
+  deskew_to_base(planes, f.plane_times, {}, SE3::identity(), velocity, f.planes);
+}
+
+}  // namespace
+
+Odometry::Odometry(OdometryConfig config, std::vector<LidarSetup> lidars)
+    : config_(std::move(config)), lidars_(std::move(lidars)), workspaces_(lidars_.size()), features_(lidars_.size()),
+      edge_map_(config_.edge_voxel_m, config_.edge_points_per_voxel), plane_map_(config_.plane_voxel_m, config_.plane_points_per_voxel) {
+  if (lidars_.empty()) throw std::invalid_argument("Odometry: no LiDARs");
+}
+
+BodyVelocity Odometry::latest_velocity() const {
+  if (centroid_poses_.size() < 2) return {};
+  const auto& a = centroid_poses_[centroid_poses_.size() - 2];
+  const auto& b = centroid_poses_.back();
+  if (!(b.stamp > a.stamp)) return {};
+  return BodyVelocity::from_relative_pose(a.T_world_base.inverse() * b.T_world_base, b.stamp - a.stamp);
+}
+
+void Odometry::update_map(const SE3& T_world_centroid, const LidarFeatures& features) {
+  std::vector<Eigen::Vector3f> world;
+  append_transformed(T_world_centroid, features.edges, world);
+  edge_map_.add(world);
+  world.clear();
+  append_transformed(T_world_centroid, features.planes, world);
+  plane_map_.add(world);
+  const Eigen::Vector3f origin = T_world_centroid.translation().cast<float>();
+  edge_map_.remove_far(origin, config_.local_map_radius_m);
+  plane_map_.remove_far(origin, config_.local_map_radius_m);
+}
+
+void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_lost) {
+  const BodyVelocity velocity = latest_velocity();
+  // World so far: the base at the first centroid, whose pose from the first stamp is Exp(t_c v).
+  const SE3 T_stamp_centroid = velocity.pose_at(first_centroid_time);
+  for (auto& pose : centroid_poses_) pose.T_world_base = T_stamp_centroid * pose.T_world_base;
+  edge_map_ = VoxelMap(config_.edge_voxel_m, config_.edge_points_per_voxel);
+  plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);
+  deskew_again(velocity, first_features_);
+  update_map(centroid_poses_.front().T_world_base, first_features_);
+  if (!second_lost) {
+    deskew_again(velocity, frame_features_);
+    update_map(centroid_poses_.back().T_world_base, frame_features_);
+  }
+  clear_features(first_features_);
+}
+
+void Odometry::adapt_threshold(const SE3& prediction, const SE3& estimate) {
+  const SE3 error = prediction.inverse() * estimate;
+  const double angle = so3_log(error.rotation()).norm();
+  const double metres = error.translation().norm() + 2.0 * config_.reference_range_m * std::sin(angle / 2.0);
+  error_sq_sum_ += metres * metres;
+  ++error_count_;
+}
+
+RegistrationResult Odometry::register_robustly(const SE3& prediction, FrameResult& frame) {
+  const double threshold = error_count_ == 0 ? config_.initial_threshold_m
+                                             : std::max(config_.min_threshold_m, 3.0 * std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)));
+  frame.threshold_m = threshold;
+  RegistrationResult best = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold, config_.registration);
+  if (best.match_ratio() >= config_.min_match_ratio) return best;
+  frame.retried = true;
+  for (const double yaw_deg : config_.retry_yaw_deg) {
+    const SE3 turn(so3_exp(Vec3(0, 0, yaw_deg * std::numbers::pi / 180.0)), Vec3::Zero());
+    // A coarse pass with the initial (wide) threshold, then a fine pass.
+    const RegistrationResult coarse = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction * turn,
+                                                           std::max(threshold, config_.initial_threshold_m), config_.registration);
+    RegistrationResult fine = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base, threshold, config_.registration);
+    if (fine.match_ratio() > best.match_ratio()) best = fine;
+    if (best.match_ratio() >= config_.min_match_ratio) break;
+  }
+  return best;
+}
+
+FrameResult Odometry::process(const Frame& frame) {
+  if (frame.scans.size() != lidars_.size()) throw std::invalid_argument("Odometry::process: frame has a different number of scans than LiDARs");
+  FrameResult result;
+  result.stamp = frame.stamp;
+  result.centroid_time = mean_point_time(frame);
+  const double centroid_stamp = frame.stamp + result.centroid_time;
+  const BodyVelocity velocity = latest_velocity();
+  const SE3 prediction = centroid_poses_.empty()
+                             ? SE3::identity()
+                             : centroid_poses_.back().T_world_base * velocity.pose_at(centroid_stamp - centroid_poses_.back().stamp);
+
+  std::vector<StageSeconds> per_lidar(lidars_.size(), StageSeconds{});
+  tbb::parallel_for(std::size_t{0}, lidars_.size(), [&](std::size_t i) {
+    run_front_end(frame.scans[i], centroid_stamp, lidars_[i], velocity, config_.front_end, workspaces_[i], features_[i], per_lidar[i]);
+  });
+  clear_features(frame_features_);
+  for (std::size_t i = 0; i < lidars_.size(); ++i) {
+    for (std::size_t s = 0; s < kStageCount; ++s) result.seconds[s] += per_lidar[i][s];
+    result.points_in += frame.scans[i].size();
+    append_features(features_[i], frame_features_);
+  }
+  result.edge_features = frame_features_.edges.size();
+  result.plane_features = frame_features_.planes.size();
+
+  auto start = std::chrono::steady_clock::now();
+  SE3 T_world_centroid = SE3::identity();
+  if (centroid_poses_.empty()) {
+    result.registration.converged = true;
+  } else {
+    result.registration = register_robustly(prediction, result);
+    T_world_centroid = result.registration.T_world_base;
+    result.lost = result.registration.match_ratio() < config_.lost_match_ratio;
+    if (result.lost) T_world_centroid = prediction;  // flagged, not silently trusted
+    else if ((prediction.inverse() * centroid_poses_.back().T_world_base).translation().norm() >= config_.min_motion_m)
+      adapt_threshold(prediction, T_world_centroid);
+  }
+  result.seconds[static_cast<std::size_t>(Stage::kRegistration)] += seconds_since(start);
+
+  start = std::chrono::steady_clock::now();
+  if (centroid_poses_.empty()) {
+    // No velocity yet: the first frame is mapped undeskewed and deskewed again once frame 2 gives one.
+    first_stamp_ = frame.stamp;
+    first_features_ = frame_features_;
+  }
+  centroid_poses_.push_back({centroid_stamp, T_world_centroid});
+  if (centroid_poses_.size() == 2) {
+    restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.lost);
+    result.registration.T_world_base = centroid_poses_.back().T_world_base;
+  } else if (!result.lost) {
+    update_map(T_world_centroid, frame_features_);
+  }
+  result.seconds[static_cast<std::size_t>(Stage::kMapUpdate)] += seconds_since(start);
+  result.T_world_base = centroid_poses_.back().T_world_base * latest_velocity().pose_at(-result.centroid_time);
+  return result;
+}
+
+}  // namespace mlidar::slam

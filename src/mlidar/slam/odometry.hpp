@@ -1,0 +1,104 @@
+#pragma once
+// Multi-LiDAR scan-to-map odometry with known extrinsics (the thesis's pure
+// odometry mode, eq 4.22, as a frame-to-local-map registration):
+//   1. predict the pose by constant velocity;
+//   2. per LiDAR, in parallel: front end, deskewed with the predicted velocity
+//      to the frame's time centroid t_c (mean capture time of its points);
+//   3. register all LiDARs' features at once against the local maps;
+//      when the match ratio is poor, retry from several yaw offsets
+//      (large unmodelled turns) and keep the best; flag the frame lost if
+//      none matches well;
+//   4. add the features to the voxel-hashed local maps, drop far voxels;
+//   5. adapt the correspondence threshold from the prediction error
+//      (KISS-ICP's adaptive threshold, Vizzo et al. 2023, eq 6-7);
+//   6. report T_world_base at the frame stamp: the registered pose at t_c
+//      moved back by t_c under the velocity between the last two t_c poses.
+// Why the time centroid: a velocity error dv shifts a cloud deskewed to a
+// time t_ref rigidly by about (t_c - t_ref) dv. Registered at the stamp
+// (t_ref = 0, t_c = 0.05 s for a 10 Hz sweep from the stamp, more for LiDARs
+// with sweep offsets), each pose error feeds the next velocity:
+// e_k = -(t_c / dt) (e_{k-1} - e_{k-2}), undamped at t_c = dt / 2 (a
+// growing period-2 oscillation beyond). At t_ref = t_c the shift vanishes
+// to first order (KISS-ICP likewise deskews to mid-sweep), and so does the
+// bias of the first frames, mapped before any velocity is known; these are
+// deskewed again (and the map rebuilt) once frame 2 gives the first velocity.
+// The world frame is the base at the first stamp: at that point the poses and
+// map are also moved from the first time centroid to the first stamp.
+// Works with one LiDAR too (T_base_lidar = identity): each LiDAR's own motion.
+#include <vector>
+
+#include "mlidar/slam/frontend.hpp"
+#include "mlidar/slam/scan_to_map.hpp"
+#include "mlidar/slam/voxel_map.hpp"
+
+namespace mlidar::slam {
+
+struct OdometryConfig {
+  FrontEndConfig front_end;
+  RegistrationConfig registration;
+  double plane_voxel_m = 1.0;
+  double edge_voxel_m = 1.0;
+  int plane_points_per_voxel = 20;
+  int edge_points_per_voxel = 10;
+  double local_map_radius_m = 100.0;
+  double initial_threshold_m = 2.0;   ///< correspondence distance before any motion is seen
+  double min_threshold_m = 0.3;
+  double min_motion_m = 0.1;          ///< predictions moving less are not used to adapt
+  double reference_range_m = 30.0;    ///< converts rotation error into metres
+  double min_match_ratio = 0.5;       ///< below this the yaw retries run
+  double lost_match_ratio = 0.3;      ///< below this after retries the frame is lost
+  std::vector<double> retry_yaw_deg = {15, -15, 30, -30, 45, -45, 60, -60};
+};
+
+struct FrameResult {
+  double stamp = 0.0;
+  SE3 T_world_base;                 ///< at `stamp`
+  double centroid_time = 0.0;       ///< mean point time, seconds after `stamp`
+  RegistrationResult registration;  ///< its T_world_base: the pose at stamp + centroid_time
+  StageSeconds seconds{};
+  std::size_t points_in = 0;
+  std::size_t edge_features = 0;
+  std::size_t plane_features = 0;
+  double threshold_m = 0.0;
+  bool retried = false;
+  bool lost = false;
+};
+
+class Odometry {
+ public:
+  /// Throws std::invalid_argument for no LiDARs.
+  Odometry(OdometryConfig config, std::vector<LidarSetup> lidars);
+
+  /// frame.scans in the order of the LiDARs given at construction; stamps increasing.
+  FrameResult process(const Frame& frame);
+
+  const VoxelMap& plane_map() const { return plane_map_; }
+  const VoxelMap& edge_map() const { return edge_map_; }
+  const std::vector<LidarSetup>& lidars() const { return lidars_; }
+
+ private:
+  /// Constant velocity between the last two centroid poses (zero before two).
+  BodyVelocity latest_velocity() const;
+  RegistrationResult register_robustly(const SE3& prediction, FrameResult& frame);
+  void adapt_threshold(const SE3& prediction, const SE3& estimate);
+  void update_map(const SE3& T_world_centroid, const LidarFeatures& features);
+  /// At the second frame, once a velocity is known: moves the world from the
+  /// first frame's centroid pose to its stamp pose and rebuilds the map from
+  /// the first two frames' features deskewed with that velocity.
+  void restart_with_first_velocity(double first_centroid_time, bool second_lost);
+
+  OdometryConfig config_;
+  std::vector<LidarSetup> lidars_;
+  std::vector<FrontEndWorkspace> workspaces_;
+  std::vector<LidarFeatures> features_;
+  LidarFeatures frame_features_;  ///< all LiDARs' features of the current frame
+  LidarFeatures first_features_;  ///< the first frame's, kept until the second frame
+  VoxelMap edge_map_;
+  VoxelMap plane_map_;
+  std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid
+  double first_stamp_ = 0.0;
+  double error_sq_sum_ = 0.0;
+  std::size_t error_count_ = 0;
+};
+
+}  // namespace mlidar::slam

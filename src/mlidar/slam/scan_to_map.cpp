@@ -1,0 +1,175 @@
+#include "mlidar/slam/scan_to_map.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include "mlidar/slam/residuals.hpp"
+
+namespace mlidar::slam {
+namespace {
+
+/// Sums of one Gauss-Newton linearisation.
+struct NormalEquations {
+  Mat6 H = Mat6::Zero();
+  Vec6 g = Vec6::Zero();
+  double residual_sum = 0.0;
+  std::size_t planes = 0;
+  std::size_t edges = 0;
+
+  template <int Rows>
+  void add(const Eigen::Matrix<double, Rows, 1>& r, const Eigen::Matrix<double, Rows, 6>& J, double w) {
+    H.noalias() += w * J.transpose() * J;
+    g.noalias() += w * J.transpose() * r;
+    residual_sum += r.norm();
+  }
+  NormalEquations& operator+=(const NormalEquations& o) {
+    H += o.H; g += o.g;
+    residual_sum += o.residual_sum; planes += o.planes; edges += o.edges;
+    return *this;
+  }
+};
+
+struct Neighbourhood {
+  Vec3 mean;
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+};
+
+bool fit(const std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors>& points, int count, Neighbourhood& out) {
+  Vec3 mean = Vec3::Zero();
+  for (int i = 0; i < count; ++i) mean += points[static_cast<std::size_t>(i)].cast<double>();
+  mean /= count;
+  Mat3 covariance = Mat3::Zero();
+  for (int i = 0; i < count; ++i) {
+    const Vec3 d = points[static_cast<std::size_t>(i)].cast<double>() - mean;
+    covariance.noalias() += d * d.transpose();
+  }
+  out.mean = mean;
+  out.eigen.computeDirect(covariance / count);
+  return out.eigen.info() == Eigen::Success;
+}
+
+struct Matcher {
+  const VoxelMap& edge_map;
+  const VoxelMap& plane_map;
+  const SE3& T;
+  const RegistrationConfig& config;
+  float neighborhood_sq;    ///< squared search radius for the map neighbours
+  double max_residual_m;    ///< correspondences with a larger |r| are rejected
+  double huber_delta;
+
+  void plane(const Eigen::Vector3f& p, NormalEquations& eq) const {
+    std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
+    const Vec3 q = T * Vec3(p.cast<double>());
+    const int count = plane_map.nearest(q.cast<float>(), config.neighbors, neighborhood_sq, near);
+    Neighbourhood hood;
+    if (count < 3 || !fit(near, count, hood)) return;
+    // Colinear neighbours (one scan line) leave the normal's direction free about the line.
+    if (hood.eigen.eigenvalues()(1) < config.plane_spread * hood.eigen.eigenvalues()(0)) return;
+    const PlaneCoefficients plane{hood.eigen.eigenvectors().col(0), -hood.eigen.eigenvectors().col(0).dot(hood.mean)};
+    for (int i = 0; i < count; ++i)
+      if (std::abs(plane.normal.dot(near[static_cast<std::size_t>(i)].cast<double>()) + plane.offset) > config.plane_tolerance_m) return;
+    Vec3 r;
+    Mat36 J;
+    plane_residual(plane, q, r, J);
+    if (r.norm() > max_residual_m) return;
+    eq.add(r, J, huber_weight(r.norm(), huber_delta));
+    ++eq.planes;
+  }
+
+  void edge(const Eigen::Vector3f& p, NormalEquations& eq) const {
+    std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
+    const Vec3 q = T * Vec3(p.cast<double>());
+    const int count = edge_map.nearest(q.cast<float>(), config.neighbors, neighborhood_sq, near);
+    Neighbourhood hood;
+    if (count < 3 || !fit(near, count, hood)) return;
+    const Vec3 values = hood.eigen.eigenvalues();
+    if (values(2) < config.edge_linearity * values(1)) return;
+    const Vec3 direction = hood.eigen.eigenvectors().col(2);
+    for (int i = 0; i < count; ++i) {
+      const Vec3 d = near[static_cast<std::size_t>(i)].cast<double>() - hood.mean;
+      if ((d - direction.dot(d) * direction).norm() > config.edge_tolerance_m) return;
+    }
+    const EdgePlanes planes = edge_planes(hood.mean, direction, q);
+    Eigen::Matrix<double, 6, 1> r;
+    Eigen::Matrix<double, 6, 6> J;
+    Vec3 r1;
+    Mat36 J1;
+    plane_residual(planes.first, q, r1, J1);
+    r.head<3>() = r1;
+    J.topRows<3>() = J1;
+    plane_residual(planes.second, q, r1, J1);
+    r.tail<3>() = r1;
+    J.bottomRows<3>() = J1;
+    if (r.norm() > max_residual_m) return;
+    eq.add(r, J, huber_weight(r.norm(), huber_delta));
+    ++eq.edges;
+  }
+};
+
+NormalEquations linearise(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const Matcher& matcher) {
+  const std::size_t total = edges.size() + planes.size();
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, total, 256), NormalEquations{},
+      [&](const tbb::blocked_range<std::size_t>& range, NormalEquations eq) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          if (i < edges.size()) {
+            matcher.edge(edges[i], eq);
+          } else {
+            matcher.plane(planes[i - edges.size()], eq);
+          }
+        }
+        return eq;
+      },
+      [](NormalEquations a, const NormalEquations& b) { return a += b; });
+}
+
+/// Degeneracy at the solution. Early iterations, far from it, may match mostly
+/// one surface (the ground), so this is judged once, at the end: the
+/// correction from `initial` loses its translation along the weak direction.
+void keep_initial_along_weak_translation(const SE3& initial, double threshold, RegistrationResult& result) {
+  // Translation block of H: sum w J_t^T J_t = sum w n n^T over the residual normals.
+  const Eigen::SelfAdjointEigenSolver<Mat3> translation(result.hessian.topLeftCorner<3, 3>());
+  const Vec3 spread = translation.eigenvalues();
+  result.translation_observability = spread(2) > 0.0 ? spread(0) / spread(2) : 0.0;
+  result.degenerate = result.translation_observability < threshold;
+  if (!result.degenerate) return;
+  Vec6 correction = (result.T_world_base * initial.inverse()).log();
+  const Vec3 weak = translation.eigenvectors().col(0);
+  correction.head<3>() -= weak * weak.dot(correction.head<3>());
+  result.T_world_base = SE3::exp(correction) * initial;
+}
+
+}  // namespace
+
+RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_base, std::span<const Eigen::Vector3f> planes_base,
+                                        const VoxelMap& edge_map, const VoxelMap& plane_map, const SE3& initial,
+                                        double max_correspondence_m, const RegistrationConfig& config) {
+  RegistrationResult result;
+  result.T_world_base = initial;
+  result.queries = edges_base.size() + planes_base.size();
+  const double radius = std::max(max_correspondence_m, config.neighborhood_radius_m);
+  const auto neighborhood_sq = static_cast<float>(radius * radius);
+  for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
+    const Matcher matcher{edge_map, plane_map, result.T_world_base, config, neighborhood_sq, max_correspondence_m, config.huber_delta_m};
+    const NormalEquations eq = linearise(edges_base, planes_base, matcher);
+    result.iterations = iteration + 1;
+    result.plane_matches = eq.planes;
+    result.edge_matches = eq.edges;
+    result.hessian = eq.H;
+    if (eq.planes + eq.edges < 6) return result;
+    result.mean_residual_m = eq.residual_sum / static_cast<double>(eq.planes + eq.edges);
+    const Vec6 delta = eq.H.ldlt().solve(-eq.g);
+    if (!delta.allFinite()) return result;
+    result.T_world_base = SE3::exp(delta) * result.T_world_base;
+    if (delta.head<3>().norm() < config.convergence_translation_m && delta.tail<3>().norm() < config.convergence_rotation_rad) {
+      result.converged = true;
+      break;
+    }
+  }
+  result.eigenvalues = Eigen::SelfAdjointEigenSolver<Mat6>(result.hessian).eigenvalues();
+  keep_initial_along_weak_translation(initial, config.degeneracy_threshold, result);
+  return result;
+}
+
+}  // namespace mlidar::slam

@@ -1,0 +1,60 @@
+#pragma once
+// Voxel-hashed local map (tsl::robin_map from integer voxel coordinates to a
+// small bounded bucket of points), the structure of KISS-ICP's VoxelHashMap:
+// insertion O(1), a k-nearest query scans the 27 voxels around the query.
+// Not thread-safe for writes; const queries may run concurrently.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+#include <tsl/robin_map.h>
+
+namespace mlidar::slam {
+
+struct VoxelKey {
+  std::int32_t x = 0, y = 0, z = 0;
+  bool operator==(const VoxelKey&) const = default;
+};
+
+struct VoxelKeyHash {
+  std::size_t operator()(const VoxelKey& key) const {
+    // Teschner et al. 2003 spatial hash primes.
+    return static_cast<std::size_t>((static_cast<std::uint64_t>(static_cast<std::uint32_t>(key.x)) * 73856093ULL) ^
+                                    (static_cast<std::uint64_t>(static_cast<std::uint32_t>(key.y)) * 19349669ULL) ^
+                                    (static_cast<std::uint64_t>(static_cast<std::uint32_t>(key.z)) * 83492791ULL));
+  }
+};
+
+class VoxelMap {
+ public:
+  static constexpr int kMaxNeighbors = 8;
+
+  /// voxel_size > 0 metres; max_points_per_voxel >= 1. Throws std::invalid_argument otherwise.
+  VoxelMap(double voxel_size, int max_points_per_voxel);
+
+  /// Adds world points; a full voxel ignores new points.
+  void add(std::span<const Eigen::Vector3f> points);
+  /// Drops voxels whose first point lies farther than max_distance from origin.
+  void remove_far(const Eigen::Vector3f& origin, double max_distance);
+
+  /// Up to k (<= kMaxNeighbors) stored points nearest to q among the 27
+  /// surrounding voxels with squared distance <= max_distance_sq, nearest
+  /// first, written to out; returns how many.
+  int nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, std::array<Eigen::Vector3f, kMaxNeighbors>& out) const;
+
+  std::vector<Eigen::Vector3f> points() const;
+  std::size_t voxels() const { return map_.size(); }
+  bool empty() const { return map_.empty(); }
+  double voxel_size() const { return voxel_size_; }
+
+ private:
+  VoxelKey key_of(const Eigen::Vector3f& p) const;
+
+  double voxel_size_;
+  int max_points_;
+  tsl::robin_map<VoxelKey, std::vector<Eigen::Vector3f>, VoxelKeyHash> map_;
+};
+
+}  // namespace mlidar::slam
