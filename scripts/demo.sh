@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds Release and runs mlidar's main job on the
 # built-in default: a simulated drive of the thesis's four-LiDAR vehicle (rig
-# rv, scene campus, trajectory vehicle, 100 frames, seed 1). Everything goes
-# to ./mlidar_demo (or the folder given as the first argument).
+# rv, scene campus, trajectory vehicle, 100 frames, seed 1), then multi-LiDAR
+# odometry on it, evaluated against the simulator's ground truth. Everything
+# goes to ./mlidar_demo (or the folder given as the first argument).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out=${1:-"$PWD/mlidar_demo"}
@@ -27,3 +28,11 @@ echo "  ground truth: $(ls "$dataset/groundtruth" | tr '\n' ' ')"
 echo "  size: $(du -sh "$dataset" | cut -f1)"
 echo "== first scan of the top LiDAR"
 "$mlidar" info "$dataset/scans/top/000000.pcd"
+
+run="$out/odometry"
+rm -rf "$run"
+echo "== multi-LiDAR odometry (all four LiDARs at once) into $run"
+"$mlidar" odometry --dataset "$dataset" --out "$run"
+echo "== accuracy against the ground truth (plot: $run/trajectory.svg)"
+"$mlidar" eval traj --gt "$dataset/groundtruth/trajectory.tum" --est "$run/trajectory.tum" \
+  --json "$run/eval.json" --plot "$run/trajectory.svg"
