@@ -52,47 +52,42 @@ double ate_rmse(const Trajectory& gt, const Trajectory& est) {
   return report.ate.translation_m.rmse;
 }
 
-class CliOdometry : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    sim_ = new fs::path(fs::temp_directory_path() / "mlidar_tests" / "CliOdometry.sim");
-    fs::remove_all(*sim_);
-    const auto result = run_cli("simulate drive --rig rv --scene campus --trajectory vehicle --frames " + std::to_string(kFrames) +
-                                " --seed 5 --out " + quoted(sim_->string()));
-    ASSERT_EQ(result.exit_code, 0) << result.output;
-  }
-  static void TearDownTestSuite() {
-    fs::remove_all(*sim_);
-    delete sim_;
-  }
-  static fs::path* sim_;
-};
+/// Simulates the drive into dir/sim (per test: ctest runs tests as parallel processes).
+fs::path simulate_drive(const fs::path& dir) {
+  const fs::path sim = dir / "sim";
+  const auto result = run_cli("simulate drive --rig rv --scene campus --trajectory vehicle --frames " + std::to_string(kFrames) +
+                              " --seed 5 --out " + quoted(sim.string()));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  return sim;
+}
 
-fs::path* CliOdometry::sim_ = nullptr;
-
-TEST_F(CliOdometry, DatasetRunTracksTheGroundTruth) {
-  const fs::path run = scratch_dir() / "run";
-  const auto result = run_cli("odometry --dataset " + quoted(sim_->string()) + " --out " + quoted(run.string()));
+TEST(CliOdometry, DatasetRunTracksTheGroundTruth) {
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate_drive(dir);
+  const fs::path run = dir / "run";
+  const auto result = run_cli("odometry --dataset " + quoted(sim.string()) + " --out " + quoted(run.string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const Trajectory est = read_run_folder(run);
-  const Trajectory gt = io::read_tum(*sim_ / "groundtruth" / "trajectory.tum");
+  const Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");
   EXPECT_LT(ate_rmse(gt, est), kMaxAteM);
 }
 
-TEST_F(CliOdometry, ScanFolderOfOneLidarTracksThatLidar) {
-  const fs::path run = scratch_dir() / "run";
-  const auto result = run_cli("odometry --scans " + quoted((*sim_ / "scans" / "top").string()) + " --period 0.1 --out " + quoted(run.string()));
+TEST(CliOdometry, ScanFolderOfOneLidarTracksThatLidar) {
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate_drive(dir);
+  const fs::path run = dir / "run";
+  const auto result = run_cli("odometry --scans " + quoted((sim / "scans" / "top").string()) + " --period 0.1 --out " + quoted(run.string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const Trajectory est = read_run_folder(run);
   // The folder's trajectory is the top LiDAR's: T_world_top = T_world_base T_base_top.
-  Trajectory gt = io::read_tum(*sim_ / "groundtruth" / "trajectory.tum");
-  const io::Extrinsics truth = io::read_extrinsics(*sim_ / "groundtruth" / "extrinsics.yaml");
+  Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");
+  const io::Extrinsics truth = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
   ASSERT_NE(truth.find("top"), nullptr);
   for (auto& stamped : gt.poses) stamped.T_world_base = stamped.T_world_base * truth.find("top")->T_base_lidar;
   EXPECT_LT(ate_rmse(gt, est), kMaxScanFolderAteM);
 }
 
-TEST_F(CliOdometry, BadInputExitsThreeAndWritesNothing) {
+TEST(CliOdometry, BadInputExitsThreeAndWritesNothing) {
   const fs::path dir = scratch_dir();
   const fs::path run = dir / "run";
   auto result = run_cli("odometry --dataset " + quoted((dir / "missing").string()) + " --out " + quoted(run.string()));
