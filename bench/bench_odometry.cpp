@@ -1,0 +1,159 @@
+// Odometry hot paths on simulated rv/campus scans (seeded): each front-end
+// stage on the top LiDAR, one scan-to-map registration, and whole frames with
+// 1-4 of the rv rig's LiDARs (issue 7's scaling, thesis Table 4.7).
+#include <algorithm>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "mlidar/sim/acquisition.hpp"
+#include "mlidar/sim/rig.hpp"
+#include "mlidar/sim/scenes.hpp"
+#include "mlidar/sim/trajectory.hpp"
+#include "mlidar/slam/odometry.hpp"
+
+namespace mlidar::slam {
+namespace {
+
+constexpr int kFrames = 10;
+
+/// kFrames frames of the rv rig driving through campus, all LiDARs.
+struct Sequence {
+  sim::SimRig rig = sim::named_rig("rv");
+  std::vector<LidarSetup> lidars;
+  std::vector<Frame> frames;
+
+  Sequence() {
+    const auto trajectory = sim::SimTrajectory::named("vehicle", rig.base_height);
+    std::vector<Vec3> path;
+    for (int k = 0; k <= kFrames; ++k) path.push_back(trajectory.T_world_base(k * rig.frame_period()).translation());
+    const sim::Scene scene = sim::make_scene("campus", 3, path);
+    for (const auto& lidar : rig.lidars) lidars.push_back({lidar.name, lidar.model, lidar.T_base_lidar});
+    for (int k = 0; k < kFrames; ++k) {
+      Frame frame;
+      frame.stamp = k * rig.frame_period();
+      for (std::size_t i = 0; i < rig.lidars.size(); ++i)
+        frame.scans.push_back(sim::simulate_sweep(scene, rig.lidars[i], trajectory, frame.stamp, sim::sweep_seed(3, static_cast<std::uint64_t>(k), i)).scan);
+      frames.push_back(std::move(frame));
+    }
+  }
+};
+
+const Sequence& sequence() {
+  static const Sequence data;  // simulated once per process
+  return data;
+}
+
+void BM_RangeImage(benchmark::State& state) {
+  const Sequence& data = sequence();
+  const Scan& scan = data.frames[0].scans[0];
+  RangeImage image;
+  for (auto _ : state) {
+    build_range_image(scan.points, scan.ring, data.lidars[0].model, image);
+    benchmark::DoNotOptimize(image.index.data());
+  }
+  state.counters["points"] = static_cast<double>(scan.size());
+}
+BENCHMARK(BM_RangeImage)->Unit(benchmark::kMillisecond);
+
+void BM_Segmentation(benchmark::State& state) {
+  const Sequence& data = sequence();
+  const Scan& scan = data.frames[0].scans[0];
+  const LidarSetup& lidar = data.lidars[0];
+  RangeImage image;
+  build_range_image(scan.points, scan.ring, lidar.model, image);
+  std::vector<double> angles = lidar.model.vertical_angles_deg;
+  std::sort(angles.begin(), angles.end());
+  const Eigen::Vector3f up = (lidar.T_base_lidar.rotation().conjugate() * Vec3::UnitZ()).cast<float>();
+  Segmentation segmentation;
+  for (auto _ : state) {
+    segment_range_image(image, scan.points, angles, up, {}, segmentation);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Segmentation)->Unit(benchmark::kMillisecond);
+
+void BM_Features(benchmark::State& state) {
+  const Sequence& data = sequence();
+  const Scan& scan = data.frames[0].scans[0];
+  const LidarSetup& lidar = data.lidars[0];
+  RangeImage image;
+  build_range_image(scan.points, scan.ring, lidar.model, image);
+  std::vector<double> angles = lidar.model.vertical_angles_deg;
+  std::sort(angles.begin(), angles.end());
+  Segmentation segmentation;
+  segment_range_image(image, scan.points, angles, (lidar.T_base_lidar.rotation().conjugate() * Vec3::UnitZ()).cast<float>(), {}, segmentation);
+  FeatureWorkspace workspace;
+  FeatureIndices indices;
+  for (auto _ : state) {
+    extract_features(image, segmentation, {}, workspace, indices);
+    benchmark::DoNotOptimize(indices.planes.data());
+  }
+  state.counters["edges"] = static_cast<double>(indices.edges.size());
+  state.counters["planes"] = static_cast<double>(indices.planes.size());
+}
+BENCHMARK(BM_Features)->Unit(benchmark::kMillisecond);
+
+void BM_DeskewAllPoints(benchmark::State& state) {
+  const Sequence& data = sequence();
+  const Scan& scan = data.frames[0].scans[0];
+  BodyVelocity velocity;
+  velocity.linear = Vec3(7.5, 0.0, 0.0);
+  velocity.angular = Vec3(0.0, 0.0, 0.2);
+  std::vector<Eigen::Vector3f> out(scan.size());
+  for (auto _ : state) {
+    deskew_to_base(scan.points, scan.time, {}, data.lidars[0].T_base_lidar, velocity, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+}
+BENCHMARK(BM_DeskewAllPoints)->Unit(benchmark::kMillisecond);
+
+/// Frame 1's features of all LiDARs registered to a map of frame 0's.
+void BM_RegisterScanToMap(benchmark::State& state) {
+  const Sequence& data = sequence();
+  const OdometryConfig config;
+  std::vector<LidarFeatures> features(2);
+  for (int k = 0; k < 2; ++k) {
+    for (std::size_t i = 0; i < data.lidars.size(); ++i) {
+      FrontEndWorkspace ws;
+      LidarFeatures one;
+      StageSeconds seconds{};
+      run_front_end(data.frames[static_cast<std::size_t>(k)].scans[i], data.frames[static_cast<std::size_t>(k)].stamp, data.lidars[i], {},
+                    config.front_end, ws, one, seconds);
+      auto& all = features[static_cast<std::size_t>(k)];
+      all.edges.insert(all.edges.end(), one.edges.begin(), one.edges.end());
+      all.planes.insert(all.planes.end(), one.planes.begin(), one.planes.end());
+    }
+  }
+  VoxelMap edge_map(config.edge_voxel_m, config.edge_points_per_voxel);
+  VoxelMap plane_map(config.plane_voxel_m, config.plane_points_per_voxel);
+  edge_map.add(features[0].edges);
+  plane_map.add(features[0].planes);
+  const SE3 guess(Quat::Identity(), Vec3(0.7, 0.0, 0.0));  // ~0.1 m off the true 0.75 m step
+  RegistrationResult result;
+  for (auto _ : state) {
+    result = register_scan_to_map(features[1].edges, features[1].planes, edge_map, plane_map, guess, 1.0, config.registration);
+    benchmark::DoNotOptimize(result.T_world_base);
+  }
+  state.counters["iterations"] = result.iterations;
+  state.counters["features"] = static_cast<double>(features[1].edges.size() + features[1].planes.size());
+}
+BENCHMARK(BM_RegisterScanToMap)->Unit(benchmark::kMillisecond);
+
+/// kFrames whole frames (front ends, registration, map update) with the first N LiDARs per iteration.
+void BM_OdometryFrame(benchmark::State& state) {
+  const Sequence& data = sequence();
+  const auto count = static_cast<std::size_t>(state.range(0));
+  const std::vector<LidarSetup> lidars(data.lidars.begin(), data.lidars.begin() + static_cast<std::ptrdiff_t>(count));
+  std::vector<Frame> frames = data.frames;
+  for (auto& frame : frames) frame.scans.resize(count);
+  for (auto _ : state) {
+    Odometry odometry({}, lidars);
+    for (const Frame& frame : frames) benchmark::DoNotOptimize(odometry.process(frame).T_world_base);
+  }
+  state.SetItemsProcessed(state.iterations() * kFrames);  // items_per_second = frames per second
+}
+BENCHMARK(BM_OdometryFrame)->DenseRange(1, 4)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace mlidar::slam
