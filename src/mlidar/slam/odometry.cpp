@@ -109,21 +109,31 @@ void Odometry::adapt_threshold(const SE3& prediction, const SE3& estimate) {
   ++error_count_;
 }
 
+bool Odometry::trusted(const RegistrationResult& registration) const {
+  return registration.match_ratio() >= config_.min_match_ratio &&
+         registration.mean_residual_m <= config_.trusted_mean_residual_m;
+}
+
 RegistrationResult Odometry::register_robustly(const SE3& prediction, FrameResult& frame) {
   const double threshold = error_count_ == 0 ? config_.initial_threshold_m
                                              : std::max(config_.min_threshold_m, 3.0 * std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)));
   frame.threshold_m = threshold;
   RegistrationResult best = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold, config_.registration);
-  if (best.match_ratio() >= config_.min_match_ratio) return best;
+  if (trusted(best)) return best;
   frame.retried = true;
+  // Prefer a trusted candidate; among equals, the one whose matches are tighter.
+  const auto better = [this](const RegistrationResult& a, const RegistrationResult& b) {
+    if (trusted(a) != trusted(b)) return trusted(a);
+    return a.mean_residual_m < b.mean_residual_m;
+  };
   for (const double yaw_deg : config_.retry_yaw_deg) {
     const SE3 turn(so3_exp(Vec3(0, 0, yaw_deg * std::numbers::pi / 180.0)), Vec3::Zero());
     // A coarse pass with the initial (wide) threshold, then a fine pass.
     const RegistrationResult coarse = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction * turn,
                                                            std::max(threshold, config_.initial_threshold_m), config_.registration);
     RegistrationResult fine = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base, threshold, config_.registration);
-    if (fine.match_ratio() > best.match_ratio()) best = fine;
-    if (best.match_ratio() >= config_.min_match_ratio) break;
+    if (better(fine, best)) best = fine;
+    if (trusted(best)) break;
   }
   return best;
 }
@@ -159,7 +169,8 @@ FrameResult Odometry::process(const Frame& frame) {
   } else {
     result.registration = register_robustly(prediction, result);
     T_world_centroid = result.registration.T_world_base;
-    result.lost = result.registration.match_ratio() < config_.lost_match_ratio;
+    result.lost = result.registration.match_ratio() < config_.lost_match_ratio ||
+                  result.registration.mean_residual_m > config_.trusted_mean_residual_m;
     if (result.lost) T_world_centroid = prediction;  // flagged, not silently trusted
     else if ((prediction.inverse() * centroid_poses_.back().T_world_base).translation().norm() >= config_.min_motion_m)
       adapt_threshold(prediction, T_world_centroid);

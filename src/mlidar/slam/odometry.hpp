@@ -46,6 +46,11 @@ struct OdometryConfig {
   double min_motion_m = 0.1;          ///< predictions moving less are not used to adapt
   double reference_range_m = 30.0;    ///< converts rotation error into metres
   double min_match_ratio = 0.5;       ///< below this the yaw retries run
+  /// A registration is trusted only when its matches are also tight: the adaptive
+  /// threshold grows after hard turns and then lets a wrong alignment match well
+  /// (real BALM keyframes 45->46, a 21 deg turn). Above this mean |r| the yaw
+  /// retries run, and a frame that stays above it is lost.
+  double trusted_mean_residual_m = 0.2;
   double lost_match_ratio = 0.3;      ///< below this after retries the frame is lost
   std::vector<double> retry_yaw_deg = {15, -15, 30, -30, 45, -45, 60, -60};
 };
@@ -80,6 +85,7 @@ class Odometry {
   /// Constant velocity between the last two centroid poses (zero before two).
   BodyVelocity latest_velocity() const;
   RegistrationResult register_robustly(const SE3& prediction, FrameResult& frame);
+  bool trusted(const RegistrationResult& registration) const;
   void adapt_threshold(const SE3& prediction, const SE3& estimate);
   void update_map(const SE3& T_world_centroid, const LidarFeatures& features);
   /// At the second frame, once a velocity is known: moves the world from the
