@@ -84,7 +84,9 @@ LidarCalibration calibrate_against_base(const io::DatasetLidar& lidar, const Lid
   out.name = lidar.name;
   out.hand_eye = calib::solve_hand_eye(motion_pairs(base, own, job.pair_stride), job.hand_eye);
   out.T_base_lidar = out.hand_eye.T_a_b;
-  out.covariance = out.hand_eye.covariance;
+  // Pairs s frames apart overlap: each frame-to-frame motion enters s pairs,
+  // so they carry about 1/s of the information the solver counts.
+  out.covariance = out.hand_eye.covariance * static_cast<double>(job.pair_stride);
   using calib::HandEyeVerdict;
   out.usable = out.hand_eye.verdict == HandEyeVerdict::ok;
   if (out.hand_eye.verdict == HandEyeVerdict::planar_motion) {
