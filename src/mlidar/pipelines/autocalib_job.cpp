@@ -78,6 +78,28 @@ Mat6 with_ground_variance(Mat6 covariance, const Vec3& axis, const calib::Ground
   return covariance;
 }
 
+/// General motion: the ground planes still measure the height along the
+/// base's z (LiDARs mounted near level, thesis 3.3); fused with the hand-eye
+/// estimate by their variances along that axis (a scalar Kalman update of the
+/// translation; the rotation is left as hand-eye found it, since odometry
+/// biases make its correlation with the height unreliable).
+void fuse_ground_height(const LidarMotion& base, const LidarMotion& own, const AutoCalibJob& job, LidarCalibration& out) {
+  const Vec3 axis = Vec3::UnitZ();
+  const calib::GroundHeightResult ground =
+      calib::height_from_ground(base.ground_scans, own.ground_scans, out.T_base_lidar, axis, job.ground);
+  if (ground.frames_used < 3) return;
+  const double n = static_cast<double>(ground.frames_used);
+  const double variance_ground = std::max(ground.spread_m * ground.spread_m, 1e-6) / n;
+  const Vec6 h = (Vec6() << axis, Vec3::Zero()).finished();
+  const double variance_hand_eye = h.dot(out.covariance * h);
+  Vec6 gain = out.covariance * h / (variance_hand_eye + variance_ground);
+  gain.tail<3>().setZero();
+  out.T_base_lidar = SE3(out.T_base_lidar.rotation(), out.T_base_lidar.translation() + gain.head<3>() * ground.shift_m);
+  const Mat6 I_KH = Mat6::Identity() - gain * h.transpose();  // Joseph form: PSD for any gain
+  out.covariance = I_KH * out.covariance * I_KH.transpose() + variance_ground * gain * gain.transpose();
+  out.ground = ground;
+}
+
 LidarCalibration calibrate_against_base(const io::DatasetLidar& lidar, const LidarMotion& base, const LidarMotion& own,
                                         const AutoCalibJob& job) {
   LidarCalibration out;
@@ -95,6 +117,8 @@ LidarCalibration calibrate_against_base(const io::DatasetLidar& lidar, const Lid
     out.usable = out.ground->frames_used > 0;
     out.T_base_lidar = out.ground->T_a_b;
     if (out.usable) out.covariance = with_ground_variance(out.covariance, axis, *out.ground);
+  } else if (out.usable) {
+    fuse_ground_height(base, own, job, out);
   }
   for (const bool lost : own.lost) out.odometry_lost_frames += lost ? 1 : 0;
   return out;
