@@ -1,6 +1,9 @@
 // `mlidar calibrate planes`: PS-Calib (thesis Chap. 2) from one scan of each
-// LiDAR looking at a wall corner. `calibrate` is the parent of the solvers.
+// LiDAR looking at a wall corner. `mlidar calibrate auto`: Auto-Calib (thesis
+// Chap. 3) from a dataset folder's motion. `calibrate` is the parent of the solvers.
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -11,11 +14,13 @@
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/planes_config_yaml.hpp"
 #include "mlidar/calib/planes_calibrator.hpp"
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
 #include "mlidar/io/file_bytes.hpp"
+#include "mlidar/pipelines/autocalib_job.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -122,6 +127,42 @@ int run_planes(const PlanesOptions& options) {
   return options.strict && !result.ok() ? static_cast<int>(ExitCode::kUntrusted) : 0;
 }
 
+struct AutoOptions {
+  std::string dataset;
+  std::string base;
+  std::string stage = "handeye";
+  int pair_stride = 5;
+  std::string out;
+};
+
+int run_auto(const AutoOptions& options) {
+  pipelines::AutoCalibJob job;
+  job.dataset = options.dataset;
+  job.base = options.base;
+  job.stage = options.stage;
+  job.pair_stride = options.pair_stride;
+  job.out = options.out;
+  const auto summary = pipelines::run_autocalib_job(job);
+  std::printf("%-10s %-18s %6s %6s %28s %28s %9s %9s\n", "lidar", "verdict", "used", "reject", "t [m]",
+              "rpy [deg]", "sd_t [m]", "sd_r [deg]");
+  for (const auto& c : summary.lidars) {
+    const bool is_base = c.name == summary.base;
+    const std::string verdict = is_base ? "base" : std::string(calib::to_string(c.hand_eye.verdict)) + (c.ground ? "+ground" : "");
+    const Vec3 t = c.T_base_lidar.translation();
+    const Vec3 rpy = rpy_deg_from_quat(c.T_base_lidar.rotation());
+    const double sd_t = std::sqrt(c.covariance.topLeftCorner<3, 3>().trace());
+    const double sd_r = rad_to_deg(std::sqrt(c.covariance.bottomRightCorner<3, 3>().trace()));
+    std::printf("%-10s %-18s %6zu %6zu %9.4f %9.4f %9.4f %9.3f %9.3f %9.3f %9.4f %9.4f\n", c.name.c_str(), verdict.c_str(),
+                c.hand_eye.pairs_used, c.hand_eye.pairs_rejected, t.x(), t.y(), t.z(), rpy.x(), rpy.y(), rpy.z(), sd_t, sd_r);
+  }
+  std::cout << "wrote " << options.out << " (extrinsics.yaml, calibration.json) in " << summary.seconds << " s\n";
+  if (!summary.all_usable()) {
+    std::cerr << "error: a LiDAR could not be calibrated from this motion (see calibration.json: verdict, message)\n";
+    return static_cast<int>(ExitCode::kUntrusted);
+  }
+  return 0;
+}
+
 }  // namespace
 
 Command register_calibrate(CLI::App& app) {
@@ -136,7 +177,16 @@ Command register_calibrate(CLI::App& app) {
   planes_cmd->add_option("--out", planes->out, "Output extrinsics YAML (T_ref_target with covariance)")->required();
   planes_cmd->add_option("--report", planes->report, "JSON report: planes, angles, residuals, verdict");
   planes_cmd->add_flag("--strict", planes->strict, "Exit 1 when the verdict carries a warning");
-  return {sub, [planes] { return run_planes(*planes); }};
+  auto autocal = std::make_shared<AutoOptions>();
+  CLI::App* auto_cmd = sub->add_subcommand("auto", "Target-less calibration of every LiDAR from its own motion (hand-eye)");
+  auto_cmd->add_option("--dataset", autocal->dataset, "Dataset folder (dataset.yaml, times.txt, scans/)")->required();
+  auto_cmd->add_option("--base", autocal->base, "Base LiDAR (default: the dataset's base)");
+  auto_cmd->add_option("--stage", autocal->stage, "Stage to run: handeye")->capture_default_str();
+  auto_cmd->add_option("--pair-stride", autocal->pair_stride, "Frames between the ends of a motion pair")->capture_default_str();
+  auto_cmd->add_option("--out", autocal->out, "Run folder: extrinsics.yaml, calibration.json")->required();
+  auto planes_run = [planes] { return run_planes(*planes); };
+  auto auto_run = [autocal] { return run_auto(*autocal); };
+  return {sub, [sub, planes_cmd, planes_run, auto_run] { return sub->got_subcommand(planes_cmd) ? planes_run() : auto_run(); }};
 }
 
 }  // namespace mlidar::cli

@@ -58,9 +58,9 @@ Inputs scan_folder_inputs(const OdometryJob& job) {
   return in;
 }
 
-/// Reads a cloud; keeps the per-point times relative to the frame stamp when
-/// the file's t field holds them (the simulator's convention).
-Scan load_scan(const std::filesystem::path& path, double frame_stamp) {
+}  // namespace
+
+Scan load_dataset_scan(const std::filesystem::path& path, double frame_stamp) {
   const io::CloudFile cloud = io::read_cloud(path);
   Scan scan = io::to_scan(cloud.table, path.string());
   scan.stamp = frame_stamp;
@@ -71,8 +71,6 @@ Scan load_scan(const std::filesystem::path& path, double frame_stamp) {
   }
   return scan;
 }
-
-}  // namespace
 
 bool natural_less(const std::string& a, const std::string& b) {
   std::size_t i = 0, j = 0;
@@ -127,7 +125,7 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   for (std::size_t k = 0; k < in.stamps.size(); ++k) {
     Frame frame;
     frame.stamp = in.stamps[k];
-    for (const auto& file : in.files[k]) frame.scans.push_back(load_scan(file, frame.stamp));
+    for (const auto& file : in.files[k]) frame.scans.push_back(load_dataset_scan(file, frame.stamp));
     results.push_back(odometry.process(frame));
     summary.trajectory.poses.push_back({frame.stamp, results.back().T_world_base});
     if (progress) progress(static_cast<int>(k + 1), static_cast<int>(in.stamps.size()));

@@ -39,6 +39,10 @@ struct OdometryJobSummary {
 std::vector<std::filesystem::path> natural_sorted_clouds(const std::filesystem::path& folder);
 bool natural_less(const std::string& a, const std::string& b);
 
+/// Reads a cloud; keeps the per-point times relative to the frame stamp when
+/// the file's t field holds them (the simulator's convention).
+Scan load_dataset_scan(const std::filesystem::path& path, double frame_stamp);
+
 /// UsageError for a bad combination of options; InputError for bad files.
 OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<void(int, int)>& progress = {});
 
