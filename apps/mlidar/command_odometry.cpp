@@ -1,12 +1,11 @@
 // `mlidar odometry`: multi-LiDAR scan-to-map odometry over a dataset or a folder of clouds.
-#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include "apps/mlidar/commands.hpp"
+#include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
 
 namespace mlidar::cli {
@@ -29,17 +28,6 @@ std::vector<std::string> split_names(const std::string& text) {
   return names;
 }
 
-std::function<void(int, int)> progress_bar() {
-  if (isatty(fileno(stderr)) == 0) return {};
-  return [](int done, int total) {
-    const int width = 40;
-    const int filled = width * done / total;
-    std::fprintf(stderr, "\r[%s%s] %d/%d frames", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                 std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), done, total);
-    if (done == total) std::fputc('\n', stderr);
-  };
-}
-
 int run_odometry(const OdometryOptions& options) {
   pipelines::OdometryJob job;
   job.dataset = options.dataset;
@@ -48,7 +36,7 @@ int run_odometry(const OdometryOptions& options) {
   job.lidars = split_names(options.lidars);
   job.threads = options.threads;
   job.out = options.out;
-  const auto summary = pipelines::run_odometry_job(job, progress_bar());
+  const auto summary = pipelines::run_odometry_job(job, terminal_progress_bar());
   std::cout << "wrote " << options.out << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3 << " ms per frame, "
             << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost\n";
   if (summary.degenerate_frames > 0)

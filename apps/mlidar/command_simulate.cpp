@@ -1,12 +1,11 @@
 // `mlidar simulate drive|corner`: the built-in simulator with ground truth.
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
-#include <unistd.h>
 
 #include "apps/mlidar/commands.hpp"
+#include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/sim/corner_dataset.hpp"
@@ -58,18 +57,6 @@ sim::SimTrajectory load_trajectory(const std::string& name, double base_height) 
   return sim::SimTrajectory::through(io::read_tum(name));
 }
 
-/// A progress bar on stderr when it is a terminal; nothing otherwise.
-sim::ProgressFn progress_bar() {
-  if (isatty(fileno(stderr)) == 0) return {};
-  return [](int done, int total) {
-    const int width = 40;
-    const int filled = width * done / total;
-    std::fprintf(stderr, "\r[%s%s] %d/%d frames", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                 std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), done, total);
-    if (done == total) std::fputc('\n', stderr);
-  };
-}
-
 int run_drive(const DriveOptions& options) {
   sim::DriveSpec spec;
   spec.rig = sim::load_rig(options.rig);
@@ -81,7 +68,7 @@ int run_drive(const DriveOptions& options) {
   if (perturb.size() != 2 || perturb[0] < 0.0 || perturb[1] < 0.0) throw UsageError("--perturb expects DEG,M (two non-negative numbers)");
   spec.perturb_deg = perturb[0];
   spec.perturb_m = perturb[1];
-  sim::write_drive_dataset(spec, options.out, progress_bar());
+  sim::write_drive_dataset(spec, options.out, terminal_progress_bar());
   std::cout << "wrote " << options.out << ": " << spec.frames << " frames of " << spec.rig.lidars.size()
             << " LiDAR(s), rig " << spec.rig.name << ", scene " << spec.scene << ", trajectory " << options.trajectory << '\n';
   return 0;
