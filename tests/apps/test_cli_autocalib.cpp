@@ -48,6 +48,7 @@ TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
   EXPECT_EQ(estimate.base, "left");
   ASSERT_NE(estimate.find("right"), nullptr);
   ASSERT_TRUE(estimate.find("right")->covariance.has_value());
+  ASSERT_NE(truth.find("right"), nullptr);
   const SE3& T_true = truth.find("right")->T_base_lidar;
   const SE3& T_est = estimate.find("right")->T_base_lidar;
   // Hand-eye alone on 50 frames of odometry (the initial guess in dataset.yaml is not used).
@@ -62,7 +63,9 @@ TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
   const fs::path run2 = dir / "run2";
   ASSERT_EQ(run_cli("calibrate auto --dataset " + quoted(reversed.string()) + " --base left --out " +
                     quoted(run2.string())).exit_code, 0);
-  const SE3& T_reordered = io::read_extrinsics(run2 / "extrinsics.yaml").find("right")->T_base_lidar;
+  const io::Extrinsics reordered = io::read_extrinsics(run2 / "extrinsics.yaml");
+  ASSERT_NE(reordered.find("right"), nullptr);
+  const SE3 T_reordered = reordered.find("right")->T_base_lidar;
   EXPECT_LT(rotation_deg(T_est, T_reordered), 0.01);
   EXPECT_LT(translation_m(T_est, T_reordered), 0.001);
 }
