@@ -13,40 +13,16 @@
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/io/text_fields.hpp"
+#include "mlidar/io/yaml_fields.hpp"
 
 namespace mlidar::io {
 namespace {
 
-class Checker {
+// The dataset.yaml schema on top of the generic strict accessors.
+class Checker : public YamlFields {
  public:
-  explicit Checker(std::string source) : source_(std::move(source)) {}
-  [[noreturn]] void fail(const std::string& key, const std::string& problem) const { throw InputError(source_, key, problem); }
+  explicit Checker(std::string source) : YamlFields(std::move(source), "dataset.yaml") {}
 
-  void only_keys(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) const {
-    if (!map.IsMap()) fail(key, "expected a mapping");
-    for (const auto& entry : map) {
-      const auto name = entry.first.as<std::string>();
-      if (!allowed.contains(name)) fail(key.empty() ? name : key + "." + name, "unknown key (see the dataset.yaml schema)");
-    }
-  }
-  std::string text(const YAML::Node& node, const std::string& key) const {
-    if (!node) fail(key, "missing");
-    if (!node.IsScalar()) fail(key, "expected a string");
-    return node.as<std::string>();
-  }
-  double number(const YAML::Node& node, const std::string& key) const {
-    if (!node || !node.IsScalar()) fail(key, "expected a number");
-    double value = 0.0;
-    if (!YAML::convert<double>::decode(node, value) || !std::isfinite(value)) fail(key, "expected a finite number");
-    return value;
-  }
-  std::vector<double> numbers(const YAML::Node& node, const std::string& key, std::size_t count) const {
-    if (!node.IsSequence() || node.size() == 0 || (count > 0 && node.size() != count))
-      fail(key, count > 0 ? "expected a list of " + std::to_string(count) + " numbers" : "expected a non-empty list of numbers");
-    std::vector<double> values;
-    for (std::size_t i = 0; i < node.size(); ++i) values.push_back(number(node[i], key + "[" + std::to_string(i) + "]"));
-    return values;
-  }
   /// A relative path inside the dataset folder.
   std::filesystem::path inner_path(const YAML::Node& node, const std::string& key) const {
     const std::filesystem::path path = text(node, key);
@@ -89,8 +65,6 @@ class Checker {
     return lidar;
   }
 
- private:
-  std::string source_;
 };
 
 void emit_numbers(YAML::Emitter& out, std::span<const double> values) {
@@ -103,12 +77,7 @@ void emit_numbers(YAML::Emitter& out, std::span<const double> values) {
 
 Dataset parse_dataset_yaml(const std::string& text, const std::string& source) {
   const Checker check(source);
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    check.fail("(document)", std::string("not valid YAML: ") + e.what());
-  }
+  const YAML::Node root = check.load(text);
   check.only_keys(root, "", {"name", "frame_period", "base", "times", "lidars", "groundtruth"});
   Dataset dataset;
   dataset.name = check.text(root["name"], "name");

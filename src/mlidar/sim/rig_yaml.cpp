@@ -7,51 +7,17 @@
 #include <yaml-cpp/yaml.h>
 
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/yaml_fields.hpp"
 #include "mlidar/sim/lidar_models.hpp"
 #include "mlidar/sim/rig.hpp"
 
 namespace mlidar::sim {
 namespace {
 
-class Reader {
+// The rig YAML schema (see rig.hpp) on top of the generic strict accessors.
+class Reader : public io::YamlFields {
  public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& problem) const {
-    throw InputError(source_, key, problem);
-  }
-  void only_keys(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) const {
-    if (!map.IsMap()) fail(key, "expected a mapping");
-    for (const auto& entry : map) {
-      const auto name = entry.first.as<std::string>();
-      if (!allowed.contains(name)) fail(key + "." + name, "unknown key (check the spelling; see the rig YAML schema)");
-    }
-  }
-  double number(const YAML::Node& node, const std::string& key) const {
-    try {
-      const double value = node.as<double>();
-      if (!std::isfinite(value)) fail(key, "expected a finite number");
-      return value;
-    } catch (const YAML::Exception&) {
-      fail(key, "expected a number");
-    }
-  }
-  double number_in(const YAML::Node& node, const std::string& key, double lo, double hi) const {
-    const double value = number(node, key);
-    if (value < lo || value > hi) fail(key, "expected a value in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    return value;
-  }
-  std::vector<double> numbers(const YAML::Node& node, const std::string& key, std::size_t count) const {
-    if (!node.IsSequence() || (count > 0 && node.size() != count) || node.size() == 0)
-      fail(key, count > 0 ? "expected a list of " + std::to_string(count) + " numbers" : "expected a non-empty list of numbers");
-    std::vector<double> values;
-    for (std::size_t i = 0; i < node.size(); ++i) values.push_back(number(node[i], key + "[" + std::to_string(i) + "]"));
-    return values;
-  }
-  std::string text(const YAML::Node& node, const std::string& key) const {
-    if (!node || !node.IsScalar()) fail(key, "expected a string");
-    return node.as<std::string>();
-  }
+  explicit Reader(std::string source) : YamlFields(std::move(source), "rig YAML") {}
 
   LidarModel model(const YAML::Node& node, const std::string& key) const {
     if (node.IsScalar()) {
@@ -112,21 +78,14 @@ class Reader {
     return lidar;
   }
 
- private:
-  std::string source_;
 };
 
 }  // namespace
 
 SimRig parse_rig_yaml(const std::string& text, const std::string& source) {
   const Reader reader(source);
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    reader.fail("(document)", std::string("not valid YAML: ") + e.what());
-  }
-  reader.only_keys(root, "(document)", {"name", "base", "base_height", "lidars"});
+  const YAML::Node root = reader.load(text);
+  reader.only_keys(root, "", {"name", "base", "base_height", "lidars"});
   SimRig rig;
   rig.name = root["name"] ? reader.text(root["name"], "name") : "custom";
   if (root["base_height"]) rig.base_height = reader.number_in(root["base_height"], "base_height", -100.0, 100.0);
