@@ -20,6 +20,7 @@
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
 #include "mlidar/io/file_bytes.hpp"
+#include "mlidar/pipelines/autocalib_config.hpp"
 #include "mlidar/pipelines/autocalib_job.hpp"
 
 namespace mlidar::cli {
@@ -130,34 +131,62 @@ int run_planes(const PlanesOptions& options) {
 struct AutoOptions {
   std::string dataset;
   std::string base;
-  std::string stage = "handeye";
+  std::string stage = "all";
+  std::string init;
+  std::string config;
   int pair_stride = 5;
+  int threads = 0;
   std::string out;
 };
 
-int run_auto(const AutoOptions& options) {
+std::string pose_columns(const SE3& T) {
+  const Vec3 t = T.translation();
+  const Vec3 rpy = rpy_deg_from_quat(T.rotation());
+  char text[96];
+  std::snprintf(text, sizeof text, "%8.4f %8.4f %8.4f %8.3f %8.3f %8.3f", t.x(), t.y(), t.z(), rpy.x(), rpy.y(), rpy.z());
+  return text;
+}
+
+std::string refine_column(const pipelines::LidarCalibration& c) {
+  if (!c.refine) return "-";
+  const auto& r = *c.refine;
+  return std::string(pipelines::to_string(r.verdict)) + " " + std::to_string(r.average.kept.size()) + "/" +
+         std::to_string(r.candidates.size());
+}
+
+/// One row per LiDAR: hand-eye's estimate and the refined one side by side (t [m], roll pitch yaw [deg]).
+void print_auto_table(const pipelines::AutoCalibSummary& summary) {
+  std::printf("%-8s %-20s %-14s %-53s %-53s %9s %9s\n", "lidar", "hand-eye", "refine kept", "hand-eye t [m] rpy [deg]",
+              "final t [m] rpy [deg]", "sd_t [m]", "sd_r [deg]");
+  for (const auto& c : summary.lidars) {
+    const bool is_base = c.name == summary.base;
+    std::string handeye = is_base ? "base" : "-";
+    if (!is_base && c.handeye_ran)
+      handeye = std::string(calib::to_string(c.hand_eye.verdict)) + (c.ground ? "+ground" : "");
+    const std::string handeye_pose = c.handeye_ran ? pose_columns(c.T_base_lidar_handeye) : "-";
+    const double sd_t = std::sqrt(c.covariance.topLeftCorner<3, 3>().trace());
+    const double sd_r = rad_to_deg(std::sqrt(c.covariance.bottomRightCorner<3, 3>().trace()));
+    std::printf("%-8s %-20s %-14s %-53s %-53s %9.4f %9.4f\n", c.name.c_str(), handeye.c_str(), refine_column(c).c_str(),
+                handeye_pose.c_str(), pose_columns(c.T_base_lidar).c_str(), sd_t, sd_r);
+  }
+}
+
+int run_auto(const AutoOptions& options, bool pair_stride_given) {
   pipelines::AutoCalibJob job;
+  if (!options.config.empty())
+    job = pipelines::apply_autocalib_config(io::read_file_text(options.config), options.config, job);
   job.dataset = options.dataset;
   job.base = options.base;
   job.stage = options.stage;
-  job.pair_stride = options.pair_stride;
+  job.init = options.init;
+  if (pair_stride_given) job.pair_stride = options.pair_stride;
+  job.threads = options.threads;
   job.out = options.out;
   const auto summary = pipelines::run_autocalib_job(job);
-  std::printf("%-10s %-18s %6s %6s %28s %28s %9s %9s\n", "lidar", "verdict", "used", "reject", "t [m]",
-              "rpy [deg]", "sd_t [m]", "sd_r [deg]");
-  for (const auto& c : summary.lidars) {
-    const bool is_base = c.name == summary.base;
-    const std::string verdict = is_base ? "base" : std::string(calib::to_string(c.hand_eye.verdict)) + (c.ground ? "+ground" : "");
-    const Vec3 t = c.T_base_lidar.translation();
-    const Vec3 rpy = rpy_deg_from_quat(c.T_base_lidar.rotation());
-    const double sd_t = std::sqrt(c.covariance.topLeftCorner<3, 3>().trace());
-    const double sd_r = rad_to_deg(std::sqrt(c.covariance.bottomRightCorner<3, 3>().trace()));
-    std::printf("%-10s %-18s %6zu %6zu %9.4f %9.4f %9.4f %9.3f %9.3f %9.3f %9.4f %9.4f\n", c.name.c_str(), verdict.c_str(),
-                c.hand_eye.pairs_used, c.hand_eye.pairs_rejected, t.x(), t.y(), t.z(), rpy.x(), rpy.y(), rpy.z(), sd_t, sd_r);
-  }
+  print_auto_table(summary);
   std::cout << "wrote " << options.out << " (extrinsics.yaml, calibration.json) in " << summary.seconds << " s\n";
   if (!summary.all_usable()) {
-    std::cerr << "error: a LiDAR could not be calibrated from this motion (see calibration.json: verdict, message)\n";
+    std::cerr << "error: a LiDAR could not be calibrated (see calibration.json: handeye / refine verdict, message)\n";
     return static_cast<int>(ExitCode::kUntrusted);
   }
   return 0;
@@ -178,14 +207,22 @@ Command register_calibrate(CLI::App& app) {
   planes_cmd->add_option("--report", planes->report, "JSON report: planes, angles, residuals, verdict");
   planes_cmd->add_flag("--strict", planes->strict, "Exit 1 when the verdict carries a warning");
   auto autocal = std::make_shared<AutoOptions>();
-  CLI::App* auto_cmd = sub->add_subcommand("auto", "Target-less calibration of every LiDAR from its own motion (hand-eye)");
+  CLI::App* auto_cmd =
+      sub->add_subcommand("auto", "Target-less calibration of every LiDAR: hand-eye from motion, then appearance refinement");
   auto_cmd->add_option("--dataset", autocal->dataset, "Dataset folder (dataset.yaml, times.txt, scans/)")->required();
   auto_cmd->add_option("--base", autocal->base, "Base LiDAR (default: the dataset's base)");
-  auto_cmd->add_option("--stage", autocal->stage, "Stage to run: handeye")->capture_default_str();
-  auto_cmd->add_option("--pair-stride", autocal->pair_stride, "Frames between the ends of a motion pair")->capture_default_str();
+  auto_cmd->add_option("--stage", autocal->stage, "Stages: handeye, refine (needs --init) or all (hand-eye then refine)")
+      ->capture_default_str();
+  auto_cmd->add_option("--init", autocal->init,
+                       "Starting extrinsics YAML: the start of --stage refine; with all, used only where hand-eye fails");
+  auto_cmd->add_option("--config", autocal->config, "auto.yaml with the stage parameters (pair_stride, handeye, refine)");
+  CLI::Option* stride = auto_cmd->add_option("--pair-stride", autocal->pair_stride,
+                                             "Frames between the ends of a motion pair (overrides --config)")
+                            ->capture_default_str();
+  auto_cmd->add_option("--threads", autocal->threads, "Worker threads (0: all cores)")->capture_default_str();
   auto_cmd->add_option("--out", autocal->out, "Run folder: extrinsics.yaml, calibration.json")->required();
   auto planes_run = [planes] { return run_planes(*planes); };
-  auto auto_run = [autocal] { return run_auto(*autocal); };
+  auto auto_run = [autocal, stride] { return run_auto(*autocal, stride->count() > 0); };
   return {sub, [sub, planes_cmd, planes_run, auto_run] { return sub->got_subcommand(planes_cmd) ? planes_run() : auto_run(); }};
 }
 

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <chrono>
 
-#include <nlohmann/json.hpp>
+#include <memory>
+
+#include <tbb/global_control.h>
 
 #include "mlidar/core/error.hpp"
-#include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/dataset.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/pipelines/autocalib_report.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
 #include "mlidar/slam/odometry.hpp"
 
@@ -120,52 +122,10 @@ LidarCalibration calibrate_against_base(const io::DatasetLidar& lidar, const Lid
   } else if (out.usable) {
     fuse_ground_height(base, own, job, out);
   }
-  for (const bool lost : own.lost) out.odometry_lost_frames += lost ? 1 : 0;
+  out.handeye_ran = true;
+  out.T_base_lidar_handeye = out.T_base_lidar;
+  out.covariance_handeye = out.covariance;
   return out;
-}
-
-nlohmann::json pose_json(const SE3& T) {
-  const Quat& q = T.rotation();
-  return {{"translation", {T.translation().x(), T.translation().y(), T.translation().z()}},
-          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
-}
-
-nlohmann::json lidar_json(const LidarCalibration& c, bool is_base) {
-  nlohmann::json j = {{"name", c.name}, {"usable", c.usable}, {"T_base_lidar", pose_json(c.T_base_lidar)},
-                      {"covariance", std::vector<double>(c.covariance.data(), c.covariance.data() + 36)},
-                      {"odometry_lost_frames", c.odometry_lost_frames}};
-  if (is_base) return j;
-  const calib::HandEyeResult& h = c.hand_eye;
-  nlohmann::json screw = nlohmann::json::array();
-  for (const auto& s : h.screw) screw.push_back({s.angle_rad, s.pitch_m, s.inlier});
-  j["handeye"] = {{"verdict", calib::to_string(h.verdict)}, {"message", h.message},
-                  {"estimate", pose_json(h.T_a_b)}, {"pairs_used", h.pairs_used}, {"pairs_rejected", h.pairs_rejected},
-                  {"singular_values", h.singular_values}, {"t_z_observable", h.t_z_observable},
-                  {"planar_axis", {h.planar_axis_a.x(), h.planar_axis_a.y(), h.planar_axis_a.z()}},
-                  {"rotation_rms_rad", h.rotation_rms_rad}, {"translation_rms_m", h.translation_rms_m},
-                  {"screw_residuals_angle_pitch_inlier", screw}};
-  if (c.ground) {
-    j["ground"] = {{"frames_used", c.ground->frames_used}, {"shift_m", c.ground->shift_m},
-                   {"spread_m", c.ground->spread_m}};
-  }
-  return j;
-}
-
-void write_outputs(const AutoCalibJob& job, const AutoCalibSummary& summary) {
-  fs::create_directories(job.out);
-  io::Extrinsics extrinsics;
-  extrinsics.base = summary.base;
-  nlohmann::json lidars = nlohmann::json::array();
-  for (const LidarCalibration& c : summary.lidars) {
-    extrinsics.lidars.push_back({c.name, c.T_base_lidar, c.covariance});
-    lidars.push_back(lidar_json(c, c.name == summary.base));
-  }
-  io::write_extrinsics(job.out / "extrinsics.yaml", extrinsics);
-  const nlohmann::json report = {{"stage", job.stage},        {"base", summary.base},
-                                 {"pair_stride", job.pair_stride}, {"all_usable", summary.all_usable()},
-                                 {"seconds", summary.seconds}, {"lidars", lidars}};
-  const std::string text = report.dump(2);
-  io::write_atomically(job.out / "calibration.json", [&](std::ostream& out) { out << text << '\n'; });
 }
 
 std::string base_name(const AutoCalibJob& job, const io::Dataset& dataset) {
@@ -179,6 +139,64 @@ std::string base_name(const AutoCalibJob& job, const io::Dataset& dataset) {
   return has(dataset.base) ? dataset.base : dataset.lidars.front().name;
 }
 
+void check_options(const AutoCalibJob& job) {
+  if (job.stage != "handeye" && job.stage != "refine" && job.stage != "all")
+    throw UsageError("--stage: expected handeye, refine or all (got '" + job.stage + "')");
+  if (job.stage == "refine" && job.init.empty()) throw UsageError("--stage refine needs --init extrinsics.yaml");
+  if (job.stage == "handeye" && !job.init.empty())
+    throw UsageError("--init has no use with --stage handeye (hand-eye needs no initial guess)");
+  if (job.pair_stride < 1) throw UsageError("pair_stride must be >= 1");
+  if (job.threads < 0) throw UsageError("--threads must be >= 0");
+}
+
+/// T_base_lidar from --init, whatever base that file uses (it must list ours, or use it as its base).
+std::optional<SE3> init_extrinsic(const io::Extrinsics& init, const std::filesystem::path& source,
+                                  const std::string& base, const std::string& lidar) {
+  const io::LidarExtrinsic* target = init.find(lidar);
+  if (target == nullptr) return std::nullopt;
+  if (init.base == base) return target->T_base_lidar;
+  const io::LidarExtrinsic* ours = init.find(base);
+  if (ours == nullptr)
+    throw InputError(source.string(), "lidars." + base, "missing; --init must list the base LiDAR or use it as its base");
+  return ours->T_base_lidar.inverse() * target->T_base_lidar;
+}
+
+LidarFrames lidar_frames(const fs::path& folder, const io::DatasetLidar& lidar) {
+  return {lidar.name, lidar.model, natural_sorted_clouds(folder / lidar.scans)};
+}
+
+/// Stage 3 for every auxiliary LiDAR: from hand-eye's result when usable, else from --init.
+void refine_all(const AutoCalibJob& job, const io::Dataset& dataset, std::span<const double> stamps,
+                const LidarMotion& base_motion, const std::optional<io::Extrinsics>& init, AutoCalibSummary& summary) {
+  const auto base_lidar = std::find_if(dataset.lidars.begin(), dataset.lidars.end(),
+                                       [&](const auto& l) { return l.name == summary.base; });
+  BaseLocalMaps base(lidar_frames(job.dataset, *base_lidar), {{stamps.begin(), stamps.end()}, base_motion.T_world_lidar,
+                                                              base_motion.lost}, job.refine);
+  for (std::size_t i = 0; i < dataset.lidars.size(); ++i) {
+    LidarCalibration& c = summary.lidars[i];
+    if (c.name == summary.base) continue;
+    std::optional<SE3> start;
+    if (c.handeye_ran && c.usable) {
+      start = c.T_base_lidar_handeye;
+      c.refine_start = "handeye";
+    } else if (init) {
+      start = init_extrinsic(*init, job.init, summary.base, c.name);
+      if (!start && job.stage == "refine")
+        throw InputError(job.init.string(), "lidars." + c.name, "missing; --stage refine needs every LiDAR's start");
+      if (start) c.refine_start = "init";
+    }
+    if (!start) continue;  // hand-eye unusable and no --init: reported by its verdict
+    c.refine = refine_against_base(base, lidar_frames(job.dataset, dataset.lidars[i]), *start, job.refine);
+    if (c.refine->verdict != RefineVerdict::ok) {
+      c.usable = c.refine_start == "handeye";  // hand-eye's result stands; an unrefined --init does not
+      continue;
+    }
+    c.usable = true;
+    c.T_base_lidar = c.refine->T_base_target;
+    c.covariance = c.refine->average.covariance;
+  }
+}
+
 }  // namespace
 
 bool AutoCalibSummary::all_usable() const {
@@ -187,32 +205,40 @@ bool AutoCalibSummary::all_usable() const {
 
 AutoCalibSummary run_autocalib_job(const AutoCalibJob& job,
                                    const std::function<void(const std::string&, int, int)>& progress) {
-  if (job.stage != "handeye") throw UsageError("--stage: only 'handeye' is implemented (got '" + job.stage + "')");
-  if (job.pair_stride < 1) throw UsageError("pair_stride must be >= 1");
+  check_options(job);
+  std::unique_ptr<tbb::global_control> threads;
+  if (job.threads > 0)
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    static_cast<std::size_t>(job.threads));
   const auto start = std::chrono::steady_clock::now();
   const io::Dataset dataset = io::read_dataset_yaml(job.dataset / "dataset.yaml");
   const std::vector<double> stamps = io::read_times(job.dataset / dataset.times);
   AutoCalibSummary summary;
   summary.base = base_name(job, dataset);
+  std::optional<io::Extrinsics> init;
+  if (!job.init.empty()) init = io::read_extrinsics(job.init);
+  const bool run_handeye = job.stage != "refine";
   const auto ground_frames = ground_frame_indices(stamps.size(), job.ground_frames);
-  std::vector<LidarMotion> motions;
+  // Stage 1: each LiDAR's own motion (only the base's when refining alone).
+  std::vector<LidarMotion> motions(dataset.lidars.size());
   std::size_t base_index = 0;
   for (std::size_t i = 0; i < dataset.lidars.size(); ++i) {
-    motions.push_back(lidar_motion(job.dataset, dataset.lidars[i], stamps, ground_frames, progress));
-    if (dataset.lidars[i].name == summary.base) base_index = i;
+    const bool is_base = dataset.lidars[i].name == summary.base;
+    if (is_base) base_index = i;
+    if (is_base || run_handeye) motions[i] = lidar_motion(job.dataset, dataset.lidars[i], stamps, ground_frames, progress);
   }
+  // Stage 2: hand-eye per auxiliary LiDAR.
   for (std::size_t i = 0; i < dataset.lidars.size(); ++i) {
-    if (i == base_index) {
-      LidarCalibration base;
-      base.name = summary.base;
-      for (const bool lost : motions[i].lost) base.odometry_lost_frames += lost ? 1 : 0;
-      summary.lidars.push_back(base);
-    } else {
-      summary.lidars.push_back(calibrate_against_base(dataset.lidars[i], motions[base_index], motions[i], job));
-    }
+    LidarCalibration c;
+    c.name = dataset.lidars[i].name;
+    if (i != base_index && run_handeye) c = calibrate_against_base(dataset.lidars[i], motions[base_index], motions[i], job);
+    for (const bool lost : motions[i].lost) c.odometry_lost_frames += lost ? 1 : 0;
+    summary.lidars.push_back(std::move(c));
   }
+  // Stage 3: appearance refinement.
+  if (job.stage != "handeye") refine_all(job, dataset, stamps, motions[base_index], init, summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  write_outputs(job, summary);
+  write_autocalib_outputs(job, summary);
   return summary;
 }
 

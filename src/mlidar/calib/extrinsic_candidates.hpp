@@ -1,0 +1,59 @@
+#pragma once
+// Appearance refinement's arithmetic (thesis 3.4.3.2-3.4.3.3): the overlap
+// factor of two scans (eq 3.13-3.14) and the mean of the per-frame extrinsic
+// candidates with the smallest registration error, with its covariance.
+// Tangent of an extrinsic X = T_base_target here and in every output:
+// [e_t, e_r] with t_true = t + e_t, R_true = R Exp(e_r) (as eval::calibration_metrics).
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mlidar/core/se3.hpp"
+
+namespace mlidar::calib {
+
+/// Eq 3.13-3.14: Omega = |S_a| / |P_a| * |S_b| / |P_b|, where S_a holds the
+/// points of a with a point of b within `radius_m` and S_b the points of b
+/// with a point of a within it; both clouds in the same frame (b already moved
+/// by the initial extrinsic). 0 when either cloud is empty. Non-finite points
+/// are dropped first.
+double overlap_factor(std::span<const Eigen::Vector3f> points_a, std::span<const Eigen::Vector3f> points_b,
+                      double radius_m);
+
+/// One frame's registration of the target LiDAR against the base's local map.
+struct ExtrinsicCandidate {
+  std::size_t frame = 0;
+  SE3 T_base_target;
+  double error_m = 0.0;               ///< registration error (mean |point-to-plane residual|)
+  Mat6 information = Mat6::Zero();    ///< of T_base_target in the [e_t, e_r] tangent, per m^2 of residual
+};
+
+/// Information of X = T_world_base^-1 T_world_target in the [e_t, e_r] tangent
+/// from a registration's Gauss-Newton matrix H (its left perturbation
+/// T_world_target <- Exp(d) T_world_target, [rho, phi]) and residual variance:
+/// X <- Exp(Ad(T_world_base^-1) d) X, then e_t = rho' - [t]x phi', e_r = R^T phi'.
+Mat6 extrinsic_information(const Mat6& registration_hessian, double residual_variance, const SE3& T_world_base,
+                           const SE3& T_base_target);
+
+struct CandidateSelection {
+  double keep_fraction = 0.2;   ///< best fraction (by error) kept (thesis: "the minimum registration error")
+  std::size_t min_keep = 5;     ///< at least this many kept (all when fewer)
+};
+
+struct CandidateAverage {
+  SE3 T_base_target;
+  std::vector<std::size_t> kept;      ///< indices into the candidates, best first
+  Mat6 covariance_spread = Mat6::Zero();  ///< sample covariance of the kept candidates / their count
+  Mat6 covariance_icp = Mat6::Zero();     ///< inverse of the summed information of the kept candidates
+  Mat6 covariance = Mat6::Zero();         ///< reported: spread + icp
+};
+
+/// Keeps the best candidates by error and averages them on SO(3) x R^3 (the
+/// thesis's "mean values"): the rotation by the chordal mean, the translation
+/// by the arithmetic mean; then the covariance about that mean.
+/// Throws std::invalid_argument on an empty input.
+CandidateAverage average_best_candidates(std::span<const ExtrinsicCandidate> candidates,
+                                         const CandidateSelection& selection = {});
+
+}  // namespace mlidar::calib
