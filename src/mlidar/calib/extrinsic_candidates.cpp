@@ -103,9 +103,9 @@ CandidateAverage average_best_candidates(std::span<const ExtrinsicCandidate> can
     const Vec6 e = deviation(out.T_base_target, candidates[i].T_base_target);
     scatter += e * e.transpose();
   }
-  // Standard error of the mean: sample covariance (n - 1) over n.
-  const double n = static_cast<double>(keep);
-  if (keep > 1) out.covariance_spread = scatter / (n - 1.0) / n;
+  // Sample covariance, not divided by n: the candidates share the base's map
+  // and odometry errors, so their mean is not n times better than one of them.
+  if (keep > 1) out.covariance_spread = scatter / (static_cast<double>(keep) - 1.0);
   out.covariance_icp = inverse_psd(information);
   out.covariance = out.covariance_spread + out.covariance_icp;
   return out;

@@ -44,7 +44,10 @@ struct CandidateSelection {
 struct CandidateAverage {
   SE3 T_base_target;
   std::vector<std::size_t> kept;      ///< indices into the candidates, best first
-  Mat6 covariance_spread = Mat6::Zero();  ///< sample covariance of the kept candidates / their count
+  /// Sample covariance of the kept candidates about their mean (not divided by
+  /// their count: they are correlated through the base's map and odometry; on
+  /// rhd / rv drives the mean's error against the truth is of this size).
+  Mat6 covariance_spread = Mat6::Zero();
   Mat6 covariance_icp = Mat6::Zero();     ///< inverse of the summed information of the kept candidates
   Mat6 covariance = Mat6::Zero();         ///< reported: spread + icp
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "mlidar/core/error.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
@@ -13,7 +14,7 @@ namespace {
 
 /// Sigma of a zero-mean Gaussian from its mean absolute value: E|r| = sigma sqrt(2 / pi).
 double residual_variance(double mean_abs_residual) {
-  const double sigma = mean_abs_residual * std::sqrt(M_PI / 2.0);
+  const double sigma = mean_abs_residual * std::sqrt(std::numbers::pi / 2.0);
   return sigma * sigma;
 }
 
