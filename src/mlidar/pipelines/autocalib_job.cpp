@@ -162,7 +162,7 @@ std::optional<SE3> init_extrinsic(const io::Extrinsics& init, const std::filesys
 }
 
 LidarFrames lidar_frames(const fs::path& folder, const io::DatasetLidar& lidar) {
-  return {lidar.name, lidar.model, natural_sorted_clouds(folder / lidar.scans)};
+  return {lidar.name, lidar.model, folder / lidar.scans, natural_sorted_clouds(folder / lidar.scans)};
 }
 
 /// Stage 3 for every auxiliary LiDAR: from hand-eye's result when usable, else from --init.

@@ -81,7 +81,7 @@ BaseLocalMaps::BaseLocalMaps(LidarFrames base, BaseTrajectory trajectory, Refine
     : base_(std::move(base)), trajectory_(std::move(trajectory)), config_(std::move(config)) {
   const std::size_t frames = trajectory_.stamps.size();
   if (base_.clouds.size() < frames)
-    throw InputError(base_.name, "scans", "has " + std::to_string(base_.clouds.size()) + " clouds for " +
+    throw InputError(base_.folder.string(), "scans", "has " + std::to_string(base_.clouds.size()) + " clouds for " +
                                               std::to_string(frames) + " stamps");
   world_features_.resize(frames);
   overlap_points_.resize(frames);
@@ -140,7 +140,7 @@ RefineResult refine_against_base(BaseLocalMaps& base, const LidarFrames& target,
   const BaseTrajectory& trajectory = base.trajectory();
   const std::size_t frames = trajectory.stamps.size();
   if (target.clouds.size() < frames)
-    throw InputError(target.name, "scans", "has " + std::to_string(target.clouds.size()) + " clouds for " +
+    throw InputError(target.folder.string(), "scans", "has " + std::to_string(target.clouds.size()) + " clouds for " +
                                                std::to_string(frames) + " stamps");
   RefineResult result;
   result.start = T_base_target_start;

@@ -54,6 +54,7 @@ struct RefineConfig {
 struct LidarFrames {
   std::string name;
   LidarModel model;
+  std::filesystem::path folder;               ///< where the clouds are (named in errors)
   std::vector<std::filesystem::path> clouds;  ///< one per stamp
 };
 
