@@ -1,6 +1,7 @@
 #include "mlidar/calib/hand_eye_linear.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -47,11 +48,13 @@ Quat pitch_roll_from_null_space(const Eigen::Vector4d& v3, const Eigen::Vector4d
 Mat4x quaternion_left_matrix(const Quat& q) { return quaternion_matrix(q, 1.0); }
 Mat4x quaternion_right_matrix(const Quat& q) { return quaternion_matrix(q, -1.0); }
 
-QuaternionSystem quaternion_system(std::span<const MotionPair> pairs) {
+QuaternionSystem quaternion_system(std::span<const MotionPair> pairs, std::span<const double> weights) {
+  assert(weights.empty() || weights.size() == pairs.size());
   Eigen::MatrixXd Q(4 * pairs.size(), 4);
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    Q.block<4, 4>(4 * k, 0) = quaternion_left_matrix(with_nonnegative_w(pairs[k].A.rotation())) -
-                              quaternion_right_matrix(with_nonnegative_w(pairs[k].B.rotation()));
+    const double w = weights.empty() ? 1.0 : weights[k];
+    Q.block<4, 4>(4 * k, 0) = w * (quaternion_left_matrix(with_nonnegative_w(pairs[k].A.rotation())) -
+                                   quaternion_right_matrix(with_nonnegative_w(pairs[k].B.rotation())));
   }
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Q, Eigen::ComputeFullV);
   return {svd.matrixV(), svd.singularValues()};

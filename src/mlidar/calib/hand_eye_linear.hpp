@@ -19,8 +19,9 @@ struct QuaternionSystem {
   Eigen::Vector4d singular;    ///< descending
 };
 /// Eq 3.5-3.7: SVD of the stacked [left(q_A) - right(q_B)] (4N x 4), both
-/// quaternions taken with w >= 0 so that the blocks agree in sign.
-QuaternionSystem quaternion_system(std::span<const MotionPair> pairs);
+/// quaternions taken with w >= 0 so that the blocks agree in sign. `weights`
+/// is empty (all 1) or one row weight per pair (eq 4.16's w_k).
+QuaternionSystem quaternion_system(std::span<const MotionPair> pairs, std::span<const double> weights = {});
 
 /// Eq 3.3 stacked, rotation known: (R_A - I) t = R t_B - t_A by least squares.
 Vec3 translation_least_squares(std::span<const MotionPair> pairs, const Quat& R_a_b);

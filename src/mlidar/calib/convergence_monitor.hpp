@@ -1,0 +1,99 @@
+#pragma once
+// Monitoring calibration convergence, thesis Sec. 4.7.4, Algorithm 1. Per
+// LiDAR, each sliding window gives the extrinsic estimate T_base_lidar and
+// the 6x6 information matrix Lambda = J^T J of eq 4.21 w.r.t. that extrinsic:
+//   lambda = smallest eigenvalue of Lambda (the degeneracy factor);
+//   lambda > lambda_calib  -> the estimate is accepted (set as the system's extrinsic);
+//   L_calib accepted       -> mean and sample covariance Xi_calib, calibration stops.
+// (The thesis tests |L| > L_calib; here exactly L_calib accepted estimates
+// converge, so `accepted_needed` is the sample size.) The eigenvectors of
+// Lambda below lambda_calib are reported in words: the directions the motion
+// and scene left unobservable (e.g. "translation z" under planar motion).
+// Tangent order [t, r] as everywhere in mlidar; the names refer to the axes of
+// the frame the caller's tangent lives in (for a left perturbation Exp(d) T
+// of T_base_lidar: the base frame).
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mlidar/core/se3.hpp"
+
+namespace mlidar::calib {
+
+struct ConvergenceConfig {
+  double lambda_calib = 70.0;          ///< accept a window's estimate when lambda_min exceeds it
+  std::size_t accepted_needed = 25;    ///< L_calib: accepted estimates averaged at convergence
+};
+
+/// One eigen-direction of an information matrix.
+struct WeakDirection {
+  double eigenvalue = 0.0;
+  Vec6 direction = Vec6::Zero();  ///< unit, [t, r], largest component positive
+  std::string description;        ///< e.g. "translation z", "0.80 translation x + 0.60 rotation about z"
+};
+
+/// Eigenvectors of the symmetric `information` whose eigenvalue is below
+/// `threshold`, weakest first.
+std::vector<WeakDirection> weak_directions(const Mat6& information, double threshold);
+/// Words for a [t, r] direction: the single axis name when one component
+/// holds >= 90% of its squared norm, else the components holding >= 10%,
+/// largest first, with their coefficients.
+std::string describe_direction(const Vec6& direction);
+
+/// Mean on SO(3) x R^3 (Karcher mean of the rotations, arithmetic mean of the
+/// translations) and the sample covariance (divisor n - 1) of
+/// [t_i - t_mean, Log(R_i R_mean^-1)] (rotation as a left perturbation).
+struct ExtrinsicMean {
+  SE3 mean;
+  Mat6 covariance = Mat6::Zero();
+};
+/// Throws std::invalid_argument for an empty set.
+ExtrinsicMean extrinsic_mean(std::span<const SE3> samples);
+
+enum class CalibrationMode { calibrating, converged };
+std::string_view to_string(CalibrationMode mode);
+
+struct WindowVerdict {
+  double lambda_min = 0.0;
+  bool accepted = false;          ///< lambda_min > lambda_calib (line 5)
+  bool converged_now = false;     ///< this window completed L_calib (lines 8-11)
+};
+
+/// Per-LiDAR state of Algorithm 1.
+struct LidarCalibrationState {
+  CalibrationMode mode = CalibrationMode::calibrating;
+  std::vector<SE3> accepted;            ///< the set L (cleared at restart)
+  SE3 T_base_lidar;                     ///< last accepted estimate; the mean once converged
+  Mat6 covariance = Mat6::Zero();       ///< Xi_calib once converged
+  double last_lambda_min = 0.0;
+  std::size_t windows = 0;              ///< windows seen while calibrating
+  std::size_t restarts = 0;             ///< restart() calls (re-calibrations)
+  std::vector<WeakDirection> weak;      ///< of the last window's information below lambda_calib
+};
+
+class ConvergenceMonitor {
+ public:
+  /// `initial` holds each LiDAR's starting extrinsic (e.g. the online hand-eye's).
+  /// Throws std::invalid_argument for an empty rig or accepted_needed < 2 or lambda_calib <= 0.
+  ConvergenceMonitor(std::vector<SE3> initial, ConvergenceConfig config = {});
+
+  /// Algorithm 1 for one window of LiDAR `lidar` (< size()). A converged
+  /// LiDAR ignores windows (calibration stopped): the verdict says not accepted.
+  /// A non-finite estimate or information is never accepted.
+  WindowVerdict add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information);
+
+  /// Back to calibrating from the current extrinsic, L emptied (the re-calibration trigger).
+  void restart(std::size_t lidar);
+
+  const LidarCalibrationState& lidar(std::size_t index) const { return lidars_.at(index); }
+  std::size_t size() const { return lidars_.size(); }
+  bool all_converged() const;
+
+ private:
+  ConvergenceConfig config_;
+  std::vector<LidarCalibrationState> lidars_;
+};
+
+}  // namespace mlidar::calib

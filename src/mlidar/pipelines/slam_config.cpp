@@ -1,0 +1,204 @@
+#include "mlidar/pipelines/slam_config.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <type_traits>
+#include <variant>
+
+#include "mlidar/io/file_bytes.hpp"
+#include "mlidar/io/yaml_fields.hpp"
+
+namespace mlidar::pipelines {
+namespace {
+
+struct Range {
+  double lo = 0.0;
+  double hi = 0.0;
+  bool lo_open = false;
+  bool hi_open = false;
+  bool contains(double v) const { return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi); }
+};
+
+using Target = std::variant<double*, int*, std::size_t*, bool*>;
+
+struct Field {
+  const char* section;
+  const char* key;
+  Range range;  ///< unused for bool
+  const char* meaning;
+  Target target;
+};
+
+constexpr Range kPositive{0.0, 1e9, true, false};
+constexpr Range kFraction{0.0, 1.0, true, true};
+
+/// The schema: one row per key, bound to `c`'s members.
+std::vector<Field> fields(SlamConfig& c) {
+  calib::OnlineHandEyeConfig& init = c.initialization;
+  calib::ShockDetectorConfig& shock = c.shock;
+  slam::OdometryConfig& odo = c.odometry;
+  return {
+      {"initialization", "max_constraints", {2, 1e5}, "K: motion pairs kept; when full the smallest rotation is dropped",
+       &init.max_constraints},
+      {"initialization", "rotation_threshold", kPositive, "sigma_R: rotation ready when sigma_min2(Q_K) exceeds it",
+       &init.rotation_threshold},
+      {"initialization", "huber_delta_rad", {0.0, 3.15, true, false}, "eq 4.17 Huber threshold on the residual angle",
+       &init.huber_delta_rad},
+      {"initialization", "planar_ratio", kFraction, "planar motion below this eigenvalue ratio of eq 4.18",
+       &init.planar_ratio},
+      {"initialization", "translation_min_ratio", kFraction,
+       "translation solvable above this ratio (< planar_ratio)", &init.translation_min_ratio},
+      {"convergence", "lambda_calib", kPositive, "accept a window's extrinsic when lambda_min exceeds it",
+       &c.convergence.lambda_calib},
+      {"convergence", "accepted_needed", {2, 1e5}, "L_calib: accepted estimates averaged at convergence",
+       &c.convergence.accepted_needed},
+      {"window", "size", {1, 100}, "N: the window holds N + 1 states", &c.window.size},
+      {"window", "pivot", {1, 100}, "p: pivot state, origin of the local map (<= size)", &c.window.pivot},
+      {"window", "uncertainty_threshold", kPositive, "w: threshold for filtering uncertain points in mapping",
+       &c.window.uncertainty_threshold},
+      {"window", "extrinsic_covariance_scale", {1.0, 1e6}, "alpha: scale of the extrinsic covariance",
+       &c.window.extrinsic_covariance_scale},
+      {"shock", "history", {3, 1e5}, "normal frames in the robust baseline", &shock.history},
+      {"shock", "min_history", {3, 1e5}, "no decision before this many (<= history)", &shock.min_history},
+      {"shock", "threshold_mads", {0.0, 100.0, true, false}, "robust z-score of a high frame",
+       &shock.threshold_mads},
+      {"shock", "min_relative_jump", {0.0, 100.0, true, false}, "and at least this relative residual rise",
+       &shock.min_relative_jump},
+      {"shock", "consecutive", {1, 1000}, "k: high frames in a row that trigger re-calibration",
+       &shock.consecutive},
+      {"shock", "relative_to_others", {}, "score against the other LiDARs' median residual",
+       &shock.relative_to_others},
+      {"odometry", "plane_voxel_m", {0.0, 100.0, true, false}, "voxel size of the local plane map",
+       &odo.plane_voxel_m},
+      {"odometry", "edge_voxel_m", {0.0, 100.0, true, false}, "voxel size of the local edge map", &odo.edge_voxel_m},
+      {"odometry", "local_map_radius_m", {0.0, 1e4, true, false}, "voxels farther are dropped",
+       &odo.local_map_radius_m},
+      {"odometry", "max_iterations", {1, 1000}, "registration iterations per frame",
+       &odo.registration.max_iterations},
+      {"odometry", "huber_delta_m", {0.0, 100.0, true, false}, "Huber scale on point residuals (eq 4.9's rho)",
+       &odo.registration.huber_delta_m},
+  };
+}
+
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", v);
+  return text;
+}
+
+std::string short_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+std::string range_text(const Field& f) {
+  if (std::holds_alternative<bool*>(f.target)) return "true or false";
+  const bool integer = !std::holds_alternative<double*>(f.target);
+  return std::string(integer ? "an integer in " : "a number in ") + (f.range.lo_open ? "(" : "[") +
+         short_number(f.range.lo) + ", " + short_number(f.range.hi) + (f.range.hi_open ? ")" : "]");
+}
+
+std::string value_text(const Field& f) {
+  return std::visit(
+      [](auto* p) -> std::string {
+        using T = std::remove_pointer_t<decltype(p)>;
+        if constexpr (std::is_same_v<T, bool>) return *p ? "true" : "false";
+        else if constexpr (std::is_same_v<T, double>) return number_text(*p);
+        else return std::to_string(*p);
+      },
+      f.target);
+}
+
+void read_field(const io::YamlFields& yaml, const YAML::Node& node, const Field& f) {
+  const std::string key = std::string(f.section) + "." + f.key;
+  const auto wrong = [&] {
+    const std::string got = node.IsScalar() ? ", got '" + node.Scalar() + "'" : "";
+    yaml.fail(key, "expected " + range_text(f) + got);
+  };
+  if (!node.IsScalar()) wrong();
+  if (bool* const* flag = std::get_if<bool*>(&f.target)) {
+    if (!YAML::convert<bool>::decode(node, **flag)) wrong();
+    return;
+  }
+  double value = 0.0;
+  if (!YAML::convert<double>::decode(node, value) || !std::isfinite(value) || !f.range.contains(value)) wrong();
+  if (double* const* number = std::get_if<double*>(&f.target)) {
+    **number = value;
+    return;
+  }
+  if (std::floor(value) != value) wrong();
+  if (int* const* i = std::get_if<int*>(&f.target)) **i = static_cast<int>(value);
+  if (std::size_t* const* n = std::get_if<std::size_t*>(&f.target)) **n = static_cast<std::size_t>(value);
+}
+
+/// Limits that tie two keys together.
+void check_relations(const io::YamlFields& yaml, const SlamConfig& c) {
+  if (c.window.pivot > c.window.size) {
+    yaml.fail("window.pivot", "expected an integer in [1, window.size = " + std::to_string(c.window.size) + "]");
+  }
+  if (c.shock.min_history > c.shock.history) {
+    yaml.fail("shock.min_history", "expected an integer in [3, shock.history = " + std::to_string(c.shock.history) + "]");
+  }
+  if (c.initialization.translation_min_ratio >= c.initialization.planar_ratio) {
+    yaml.fail("initialization.translation_min_ratio",
+              "expected a number in (0, initialization.planar_ratio = " + short_number(c.initialization.planar_ratio) + ")");
+  }
+}
+
+}  // namespace
+
+std::vector<SlamConfigKey> slam_config_keys() {
+  SlamConfig defaults;
+  std::vector<SlamConfigKey> keys;
+  for (const Field& f : fields(defaults)) {
+    keys.push_back({std::string(f.section) + "." + f.key, range_text(f), f.meaning});
+  }
+  return keys;
+}
+
+SlamConfig parse_slam_config(const std::string& yaml_text, const std::string& source) {
+  const io::YamlFields yaml(source, "config/mloam.yaml");
+  const YAML::Node root = yaml.load(yaml_text);
+  SlamConfig config;
+  if (!root || root.IsNull()) return config;  // an empty file: all defaults
+  const std::vector<Field> schema = fields(config);
+  std::set<std::string> sections;
+  for (const Field& f : schema) sections.insert(f.section);
+  yaml.only_keys(root, "", sections);
+  for (const std::string& section : sections) {
+    const YAML::Node node = root[section];
+    if (!node) continue;
+    std::set<std::string> keys;
+    for (const Field& f : schema) {
+      if (section == f.section) keys.insert(f.key);
+    }
+    yaml.only_keys(node, section, keys);
+    for (const Field& f : schema) {
+      if (section == f.section && node[f.key]) read_field(yaml, node[f.key], f);
+    }
+  }
+  check_relations(yaml, config);
+  return config;
+}
+
+SlamConfig read_slam_config(const std::filesystem::path& file) {
+  return parse_slam_config(io::read_file_text(file), file.string());
+}
+
+std::string slam_config_yaml(const SlamConfig& config) {
+  SlamConfig copy = config;
+  std::string text;
+  std::string section;
+  for (const Field& f : fields(copy)) {
+    if (section != f.section) {
+      section = f.section;
+      text += section + ":\n";
+    }
+    text += std::string("  ") + f.key + ": " + value_text(f) + "\n";
+  }
+  return text;
+}
+
+}  // namespace mlidar::pipelines

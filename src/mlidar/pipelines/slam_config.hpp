@@ -1,0 +1,52 @@
+#pragma once
+// Parameters of `mlidar slam` (the M-LOAM back end, thesis Ch. 4) and their
+// strict reader for `--config mloam.yaml`. Defaults are Table 4.2:
+//   sigma_R = 0.25, lambda_calib = 70, L_calib = 25, N = 4, p = 2, w = 100, alpha = 1,
+// and K = 300 (Sec. 4.6.2.1). The documented example with every key is
+// config/mloam.yaml. Every key is optional (absent = default); an unknown
+// key, a wrong type or a value out of range throws InputError naming the
+// file, the key (section.key) and the allowed range.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "mlidar/calib/convergence_monitor.hpp"
+#include "mlidar/calib/online_hand_eye.hpp"
+#include "mlidar/calib/shock_detector.hpp"
+#include "mlidar/slam/odometry.hpp"
+
+namespace mlidar::pipelines {
+
+/// The sliding window (Sec. 4.7) and mapping parameters.
+struct WindowParams {
+  int size = 4;                             ///< N: the window holds N + 1 states
+  int pivot = 2;                            ///< p: the pivot state, origin of the local map, 1 <= p <= N
+  double uncertainty_threshold = 100.0;     ///< w: threshold for filtering uncertain points in mapping
+  double extrinsic_covariance_scale = 1.0;  ///< alpha >= 1: scale of the extrinsic covariance (10 under large perturbation)
+};
+
+struct SlamConfig {
+  calib::OnlineHandEyeConfig initialization;  ///< eq 4.15-4.18
+  calib::ConvergenceConfig convergence;       ///< Algorithm 1
+  WindowParams window;
+  calib::ShockDetectorConfig shock;           ///< re-calibration trigger
+  slam::OdometryConfig odometry;              ///< front end and scan-to-map registration
+};
+
+/// One documented key: "section.key", its allowed range in words, its meaning.
+struct SlamConfigKey {
+  std::string name;
+  std::string range;
+  std::string meaning;
+};
+/// Every key the reader accepts, in file order.
+std::vector<SlamConfigKey> slam_config_keys();
+
+/// Parses YAML text; `source` names the file in errors.
+SlamConfig parse_slam_config(const std::string& yaml_text, const std::string& source);
+/// Reads a file (InputError when missing or unreadable, or for any bad key).
+SlamConfig read_slam_config(const std::filesystem::path& file);
+/// Every key with its value, in the reader's format (parse_slam_config reads it back unchanged).
+std::string slam_config_yaml(const SlamConfig& config);
+
+}  // namespace mlidar::pipelines

@@ -1,0 +1,191 @@
+// Algorithm 1 (thesis Sec. 4.7.4) on constructed information matrices.
+#include <random>
+#include <vector>
+
+#include <Eigen/QR>
+#include <gtest/gtest.h>
+
+#include "mlidar/calib/convergence_monitor.hpp"
+#include "mlidar/core/rotation_average.hpp"
+#include "mlidar/core/so3.hpp"
+
+namespace mlidar::calib {
+namespace {
+
+const SE3 kTruth(so3_exp(Vec3(0.1, -0.2, 0.3)), Vec3(0.5, -0.2, 0.1));
+
+/// A random orthonormal 6x6 basis (seeded): information = V diag(eigenvalues) V^T.
+Mat6 random_basis(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Mat6 M;
+  for (int i = 0; i < 36; ++i) M(i / 6, i % 6) = n(rng);
+  return Eigen::HouseholderQR<Mat6>(M).householderQ();
+}
+
+Mat6 information_with(const Vec6& eigenvalues, const Mat6& basis) {
+  return basis * eigenvalues.asDiagonal() * basis.transpose();
+}
+
+Mat6 information_with_min(double lambda_min, std::uint64_t seed) {
+  Vec6 values;
+  values << lambda_min, 200, 300, 400, 500, 600;
+  return information_with(values, random_basis(seed));
+}
+
+TEST(ConvergenceMonitor, AcceptsJustAboveAndRejectsJustBelowLambdaCalib) {
+  ConvergenceMonitor monitor({SE3(), SE3()});
+  const SE3 estimate(so3_exp(Vec3(0.01, 0, 0)), Vec3(0.1, 0, 0));
+  const WindowVerdict below = monitor.add_window(1, estimate, information_with_min(70.0 - 1e-6, 1));
+  EXPECT_FALSE(below.accepted);
+  EXPECT_NEAR(below.lambda_min, 70.0 - 1e-6, 1e-9);
+  EXPECT_TRUE(monitor.lidar(1).T_base_lidar.translation().isZero());  // rejected: extrinsic unchanged
+  const WindowVerdict above = monitor.add_window(1, estimate, information_with_min(70.0 + 1e-6, 2));
+  EXPECT_TRUE(above.accepted);
+  EXPECT_NEAR(above.lambda_min, 70.0 + 1e-6, 1e-9);
+  EXPECT_NEAR((monitor.lidar(1).T_base_lidar.translation() - estimate.translation()).norm(), 0.0, 1e-15);
+  EXPECT_EQ(monitor.lidar(1).accepted.size(), 1u);
+  EXPECT_EQ(monitor.lidar(0).accepted.size(), 0u);
+  EXPECT_EQ(monitor.lidar(1).windows, 2u);
+}
+
+TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
+  ConvergenceMonitor monitor({kTruth});
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0.0, 0.01);
+  int accepted = 0;
+  for (int window = 0; accepted < 25; ++window) {
+    const bool good = window % 3 != 1;  // every third window is degenerate
+    const SE3 estimate(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTruth.rotation(),
+                       kTruth.translation() + Vec3(n(rng), n(rng), n(rng)));
+    const WindowVerdict v = monitor.add_window(0, estimate, information_with_min(good ? 90.0 : 40.0, 10 + window));
+    EXPECT_EQ(v.accepted, good);
+    accepted += good ? 1 : 0;
+    EXPECT_EQ(v.converged_now, accepted == 25);
+    EXPECT_EQ(monitor.lidar(0).mode, accepted == 25 ? CalibrationMode::converged : CalibrationMode::calibrating);
+  }
+  EXPECT_TRUE(monitor.all_converged());
+  const SE3 converged = monitor.lidar(0).T_base_lidar;
+  const WindowVerdict ignored = monitor.add_window(0, SE3(), information_with_min(1000.0, 99));
+  EXPECT_FALSE(ignored.accepted);  // calibration has stopped
+  EXPECT_EQ(monitor.lidar(0).T_base_lidar.translation(), converged.translation());
+  const ExtrinsicMean direct = extrinsic_mean(monitor.lidar(0).accepted);
+  EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(direct.covariance, 1e-12));
+  EXPECT_LT(monitor.lidar(0).covariance.diagonal().maxCoeff(), 4.0 * 0.01 * 0.01);
+  EXPECT_GT(monitor.lidar(0).covariance.diagonal().minCoeff(), 0.25 * 0.01 * 0.01);
+}
+
+TEST(ExtrinsicMean, SymmetricSamplesGiveTheCentreAndTheAnalyticCovariance) {
+  // 12 pairs Exp(+-d_j) R0, t0 +- e_j and the centre itself: mean (R0, t0) exactly,
+  // covariance sum_j 2 [e_j; d_j][e_j; d_j]^T / (25 - 1).
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> n(0.0, 0.05);
+  std::vector<SE3> samples{kTruth};
+  Mat6 expected = Mat6::Zero();
+  for (int j = 0; j < 12; ++j) {
+    Vec6 x;
+    for (int i = 0; i < 6; ++i) x(i) = n(rng);
+    for (const double s : {1.0, -1.0}) {
+      samples.emplace_back(so3_exp(s * x.tail<3>()) * kTruth.rotation(), kTruth.translation() + s * x.head<3>());
+    }
+    expected += 2.0 * x * x.transpose();
+  }
+  expected /= 24.0;
+  const ExtrinsicMean mean = extrinsic_mean(samples);
+  EXPECT_LT(so3_log(mean.mean.rotation() * kTruth.rotation().conjugate()).norm(), 1e-12);
+  EXPECT_LT((mean.mean.translation() - kTruth.translation()).norm(), 1e-15);
+  EXPECT_TRUE(mean.covariance.isApprox(expected, 1e-10));
+}
+
+TEST(ExtrinsicMean, RandomSamplesSatisfyTheKarcherConditionAndMatchTheChordalMean) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n(0.0, 0.1);
+  std::vector<SE3> samples;
+  std::vector<Quat> rotations;
+  for (int i = 0; i < 25; ++i) {
+    samples.emplace_back(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTruth.rotation(), Vec3(n(rng), n(rng), n(rng)));
+    rotations.push_back(samples.back().rotation());
+  }
+  const ExtrinsicMean mean = extrinsic_mean(samples);
+  Vec3 rotation_sum = Vec3::Zero();
+  Mat6 direct = Mat6::Zero();
+  for (const SE3& T : samples) {
+    Vec6 d;
+    d << T.translation() - mean.mean.translation(), so3_log(T.rotation() * mean.mean.rotation().conjugate());
+    rotation_sum += d.tail<3>();
+    direct += d * d.transpose() / 24.0;
+  }
+  EXPECT_LT(rotation_sum.norm(), 1e-12);  // first-order optimality of the geodesic L2 mean
+  EXPECT_TRUE(mean.covariance.isApprox(direct, 1e-12));
+  EXPECT_LT(so3_log(mean.mean.rotation() * chordal_mean(rotations).conjugate()).norm(), 1e-3);
+  EXPECT_THROW(extrinsic_mean({}), std::invalid_argument);
+}
+
+TEST(WeakDirections, NamesSingleAxesAndMixtures) {
+  Vec6 planar;
+  planar << 500, 500, 1e-3, 500, 500, 500;  // t_z unobservable (planar motion)
+  const auto weak = weak_directions(planar.asDiagonal(), 70.0);
+  ASSERT_EQ(weak.size(), 1u);
+  EXPECT_EQ(weak[0].description, "translation z");
+  EXPECT_NEAR(weak[0].eigenvalue, 1e-3, 1e-12);
+
+  Vec6 two;
+  two << 500, 500, 10, 500, 20, 500;  // t_z and rotation about y, weakest first
+  const auto both = weak_directions(two.asDiagonal(), 70.0);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_EQ(both[0].description, "translation z");
+  EXPECT_EQ(both[1].description, "rotation about y");
+  EXPECT_TRUE(weak_directions(two.asDiagonal(), 5.0).empty());
+
+  Vec6 mixed = Vec6::Zero();
+  mixed(0) = -0.8;
+  mixed(5) = 0.6;  // -0.8 t_x + 0.6 r_z, reported with the largest component positive
+  EXPECT_EQ(describe_direction(mixed), "0.80 translation x - 0.60 rotation about z");
+  // Built into an information matrix: the same words come back.
+  Mat6 basis = Mat6::Identity();
+  basis.col(0) = mixed;
+  basis.col(5) = Vec6(0.6, 0, 0, 0, 0, 0.8);
+  Vec6 values;
+  values << 1.0, 300, 300, 300, 300, 300;
+  const auto rotated = weak_directions(information_with(values, basis), 70.0);
+  ASSERT_EQ(rotated.size(), 1u);
+  EXPECT_EQ(rotated[0].description, "0.80 translation x - 0.60 rotation about z");
+  EXPECT_NEAR(rotated[0].direction(0), 0.8, 1e-12);
+}
+
+TEST(ConvergenceMonitor, WeakDirectionsOfTheLastWindowAreReportedPerLidar) {
+  ConvergenceMonitor monitor({SE3(), SE3()});
+  Vec6 planar;
+  planar << 500, 500, 2.0, 500, 500, 500;
+  monitor.add_window(1, kTruth, planar.asDiagonal());
+  ASSERT_EQ(monitor.lidar(1).weak.size(), 1u);
+  EXPECT_EQ(monitor.lidar(1).weak[0].description, "translation z");
+  EXPECT_TRUE(monitor.lidar(0).weak.empty());
+  EXPECT_DOUBLE_EQ(monitor.lidar(1).last_lambda_min, 2.0);
+}
+
+TEST(ConvergenceMonitor, RestartReturnsToCalibratingWithAnEmptySet) {
+  ConvergenceConfig config;
+  config.accepted_needed = 3;
+  ConvergenceMonitor monitor({SE3()}, config);
+  for (int i = 0; i < 3; ++i) monitor.add_window(0, kTruth, information_with_min(100.0, 20 + i));
+  ASSERT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
+  monitor.restart(0);
+  EXPECT_EQ(monitor.lidar(0).mode, CalibrationMode::calibrating);
+  EXPECT_TRUE(monitor.lidar(0).accepted.empty());
+  EXPECT_EQ(monitor.lidar(0).restarts, 1u);
+  EXPECT_LT(so3_log(monitor.lidar(0).T_base_lidar.rotation() * kTruth.rotation().conjugate()).norm(), 1e-12);
+  EXPECT_TRUE(monitor.add_window(0, kTruth, information_with_min(100.0, 30)).accepted);
+}
+
+TEST(ConvergenceMonitor, NonFiniteInputIsNeverAccepted) {
+  ConvergenceMonitor monitor({SE3()});
+  Mat6 info = information_with_min(100.0, 40);
+  info(2, 3) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(monitor.add_window(0, kTruth, info).accepted);
+  EXPECT_THROW(ConvergenceMonitor({}), std::invalid_argument);
+  EXPECT_THROW(monitor.add_window(3, kTruth, Mat6::Identity()), std::out_of_range);
+}
+
+}  // namespace
+}  // namespace mlidar::calib

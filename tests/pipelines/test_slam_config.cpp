@@ -1,0 +1,127 @@
+// `mlidar slam --config`: Table 4.2 defaults, the documented example, a
+// write/read round trip and each kind of rejection.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "mlidar/core/error.hpp"
+#include "mlidar/io/file_bytes.hpp"
+#include "mlidar/pipelines/slam_config.hpp"
+#include "test_support.hpp"
+
+namespace mlidar::pipelines {
+namespace {
+
+const std::filesystem::path kExample = std::filesystem::path(MLIDAR_SOURCE_DIR) / "config" / "mloam.yaml";
+
+TEST(SlamConfig, DefaultsAreTable42) {
+  const SlamConfig c;
+  EXPECT_EQ(c.initialization.rotation_threshold, 0.25);  // sigma_R
+  EXPECT_EQ(c.convergence.lambda_calib, 70.0);
+  EXPECT_EQ(c.convergence.accepted_needed, 25u);         // L_calib
+  EXPECT_EQ(c.window.size, 4);                           // N
+  EXPECT_EQ(c.window.pivot, 2);                          // p
+  EXPECT_EQ(c.window.uncertainty_threshold, 100.0);      // w
+  EXPECT_EQ(c.window.extrinsic_covariance_scale, 1.0);   // alpha
+  EXPECT_EQ(c.initialization.max_constraints, 300u);     // K
+}
+
+TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
+  const std::string text = io::read_file_text(kExample);
+  EXPECT_EQ(slam_config_yaml(read_slam_config(kExample)), slam_config_yaml(SlamConfig{}));
+  for (const SlamConfigKey& key : slam_config_keys()) {
+    const std::string leaf = key.name.substr(key.name.find('.') + 1);
+    EXPECT_NE(text.find("\n  " + leaf + ":"), std::string::npos) << key.name;
+    EXPECT_FALSE(key.range.empty());
+    EXPECT_FALSE(key.meaning.empty());
+  }
+  EXPECT_EQ(slam_config_keys().size(), 22u);
+}
+
+TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
+  EXPECT_EQ(slam_config_yaml(parse_slam_config("", "empty.yaml")), slam_config_yaml(SlamConfig{}));
+  const SlamConfig c = parse_slam_config("window:\n  size: 6\n", "partial.yaml");
+  EXPECT_EQ(c.window.size, 6);
+  EXPECT_EQ(c.window.pivot, 2);
+  EXPECT_EQ(c.convergence.lambda_calib, 70.0);
+}
+
+TEST(SlamConfig, RoundTripsEveryKey) {
+  SlamConfig c;
+  c.initialization = {123, 0.5, 0.1 / 3.0, 0.07, 0.002};
+  c.convergence = {65.5, 30};
+  c.window = {6, 3, 55.25, 10.0};
+  c.shock.history = 80;
+  c.shock.min_history = 30;
+  c.shock.threshold_mads = 3.5;
+  c.shock.min_relative_jump = 0.4;
+  c.shock.consecutive = 7;
+  c.shock.relative_to_others = false;
+  c.odometry.plane_voxel_m = 0.7;
+  c.odometry.edge_voxel_m = 0.3;
+  c.odometry.local_map_radius_m = 80.0;
+  c.odometry.registration.max_iterations = 12;
+  c.odometry.registration.huber_delta_m = 0.05;
+  const std::string text = slam_config_yaml(c);
+  EXPECT_NE(text, slam_config_yaml(SlamConfig{}));
+  const SlamConfig back = parse_slam_config(text, "written.yaml");
+  EXPECT_EQ(slam_config_yaml(back), text);
+  EXPECT_EQ(back.initialization.huber_delta_rad, 0.1 / 3.0);  // 17 digits: exact
+  EXPECT_EQ(back.initialization.max_constraints, 123u);
+  EXPECT_EQ(back.convergence.accepted_needed, 30u);
+  EXPECT_EQ(back.window.pivot, 3);
+  EXPECT_FALSE(back.shock.relative_to_others);
+  EXPECT_EQ(back.odometry.registration.max_iterations, 12);
+  EXPECT_EQ(back.odometry.registration.huber_delta_m, 0.05);
+}
+
+struct Rejection {
+  std::string yaml;
+  std::string field;
+  std::string words;  ///< expected in the message
+};
+
+TEST(SlamConfig, RejectsWithFileKeyAndRange) {
+  const std::vector<Rejection> cases = {
+      {"windw:\n  size: 4\n", "windw", "unknown key"},
+      {"window:\n  sise: 4\n", "window.sise", "unknown key"},
+      {"window: 4\n", "window", "expected a mapping"},
+      {"window:\n  size: four\n", "window.size", "an integer in [1, 100], got 'four'"},
+      {"window:\n  size: 4.5\n", "window.size", "an integer in [1, 100]"},
+      {"window:\n  size: 0\n", "window.size", "an integer in [1, 100]"},
+      {"window:\n  size: [4]\n", "window.size", "an integer in [1, 100]"},
+      {"window:\n  size: 3\n  pivot: 4\n", "window.pivot", "[1, window.size = 3]"},
+      {"window:\n  extrinsic_covariance_scale: 0.5\n", "window.extrinsic_covariance_scale", "a number in [1, 1e+06]"},
+      {"initialization:\n  rotation_threshold: 0\n", "initialization.rotation_threshold", "a number in (0, 1e+09]"},
+      {"initialization:\n  rotation_threshold: .nan\n", "initialization.rotation_threshold", "a number in (0, 1e+09]"},
+      {"initialization:\n  planar_ratio: 1\n", "initialization.planar_ratio", "a number in (0, 1)"},
+      {"initialization:\n  translation_min_ratio: 0.06\n", "initialization.translation_min_ratio",
+       "(0, initialization.planar_ratio = 0.05)"},
+      {"initialization:\n  max_constraints: -1\n", "initialization.max_constraints", "an integer in [2, 100000]"},
+      {"convergence:\n  lambda_calib: -70\n", "convergence.lambda_calib", "a number in (0, 1e+09]"},
+      {"convergence:\n  accepted_needed: 1\n", "convergence.accepted_needed", "an integer in [2, 100000]"},
+      {"shock:\n  relative_to_others: maybe\n", "shock.relative_to_others", "true or false, got 'maybe'"},
+      {"shock:\n  history: 10\n", "shock.min_history", "[3, shock.history = 10]"},
+      {"odometry:\n  max_iterations: 0\n", "odometry.max_iterations", "an integer in [1, 1000]"},
+      {"window: {size: 4\n", "(document)", "not valid YAML"},
+  };
+  for (const Rejection& r : cases) {
+    try {
+      parse_slam_config(r.yaml, "bad/mloam.yaml");
+      ADD_FAILURE() << "accepted: " << r.yaml;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), "bad/mloam.yaml") << r.yaml;
+      EXPECT_EQ(e.field(), r.field) << r.yaml;
+      EXPECT_NE(std::string(e.what()).find(r.words), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SlamConfig, MissingFileIsAnInputError) {
+  EXPECT_THROW(read_slam_config(test::scratch_dir() / "no_such_mloam.yaml"), InputError);
+}
+
+}  // namespace
+}  // namespace mlidar::pipelines
