@@ -7,6 +7,7 @@
 
 #include "mlidar/slam/marginalization.hpp"
 #include "mlidar/slam/window_linearize.hpp"
+#include "mlidar/slam/window_solver.hpp"
 #include "slam/window_scene.hpp"
 
 namespace mlidar::slam {
@@ -185,6 +186,35 @@ TEST(Marginalization, ShiftReindexesThePriorAndKeepsItsValue) {
   EXPECT_LT((prior_residual(problem.prior, state) - before).norm(), 1e-12);
   EXPECT_LT((before - prior.residual).norm(), 1e-12);  // dx = 0 at the linearization point
   EXPECT_THROW(shift_window(problem, state, w.problem.prior, newest), std::invalid_argument);  // still holds pose 0
+}
+
+TEST(Marginalization, SlidingThroughASequenceKeepsTheTruth) {
+  // Solve, marginalize the oldest pose, shift, repeat: with noise-free features every window
+  // lands on the truth, the prior included (it is linearized at the truth after the first solve).
+  std::mt19937_64 rng(101);
+  const test::WindowScene scene = test::room_scene(6, rng);
+  const auto true_pose = [](int k) { return SE3(so3_exp(Vec3(0.01 * k, 0.0, 0.2 * k)), Vec3(0.7 * k, 0.1 * k * k, 0.0)); };
+  const SE3 aux(so3_exp(Vec3(0.3, -0.2, 2.0)), Vec3(0.4, 0.6, -0.1));
+  WindowState state = WindowState::make({true_pose(0), true_pose(1), true_pose(2)}, {SE3(), test::perturb(aux, 0.05, 0.05, rng)}, 1, true);
+  state.T_world_base[2] = test::perturb(state.T_world_base[2], 0.1, 0.03, rng);
+  WindowProblem problem;
+  for (int window = 0; window < 4; ++window) {
+    WindowState truth = state;
+    for (int i = 0; i < 3; ++i) truth.T_world_base[static_cast<std::size_t>(i)] = true_pose(window + i);
+    truth.T_base_lidar[1] = aux;
+    const WindowProblem observed = test::observe(scene, truth, 150, rng);
+    problem.planes = observed.planes;
+    problem.edges = observed.edges;
+    const WindowSolution solution = solve_window(problem, state);
+    EXPECT_TRUE(solution.converged) << window;
+    EXPECT_LT(test::distance(solution.state.T_base_lidar[1], aux), 1e-6) << window;
+    for (int i = 0; i < 3; ++i)
+      EXPECT_LT(test::distance(solution.state.T_world_base[static_cast<std::size_t>(i)], true_pose(window + i)), 1e-6) << window << " " << i;
+    EXPECT_EQ(problem.prior.variables.empty(), window == 0);
+    state = solution.state;
+    LinearPrior prior = marginalize_frame(problem, state, 0, 0.1);
+    shift_window(problem, state, std::move(prior), test::perturb(true_pose(window + 3), 0.1, 0.03, rng));
+  }
 }
 
 }  // namespace
