@@ -1,0 +1,72 @@
+// Back end (issue 9): one sliding-window solve at the thesis's size (N = 4,
+// p = 2: 5 poses, the first 2 fixed; 2 LiDARs, the auxiliary extrinsic a
+// variable), 1500 features per LiDAR per frame (15000 correspondences, 3 in 4
+// on planes), features with 2 cm noise, the variables perturbed by 5 cm / 2 deg.
+// Single thread (tbb::global_control; the library leaves threads to the caller).
+#include <random>
+
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include "mlidar/slam/marginalization.hpp"
+#include "mlidar/slam/window_solver.hpp"
+#include "slam/window_scene.hpp"
+
+namespace {
+
+using namespace mlidar;
+using namespace mlidar::slam;
+
+struct Window {
+  WindowProblem problem;
+  WindowState initial;
+};
+
+Window make_window() {
+  std::mt19937_64 rng(7);
+  const test::WindowScene scene = test::room_scene(20, rng);
+  std::vector<SE3> poses;
+  for (int k = 0; k < 5; ++k) poses.emplace_back(so3_exp(Vec3(0.0, 0.01 * k, 0.1 * k)), Vec3(0.5 * k, 0.05 * k, 0.0));
+  const std::vector<SE3> extrinsics{SE3(), SE3(so3_exp(Vec3(0.2, -0.1, 1.6)), Vec3(0.4, -0.3, 0.1))};
+  Window window;
+  window.initial = WindowState::make(poses, extrinsics, 2, true);
+  window.problem = test::observe(scene, window.initial, 1500, rng);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  for (auto& c : window.problem.planes) c.point_lidar += Vec3(noise(rng), noise(rng), noise(rng));
+  for (auto& c : window.problem.edges) c.point_lidar += Vec3(noise(rng), noise(rng), noise(rng));
+  for (std::size_t i = 2; i < poses.size(); ++i) window.initial.T_world_base[i] = test::perturb(poses[i], 0.05, 0.035, rng);
+  window.initial.T_base_lidar[1] = test::perturb(extrinsics[1], 0.05, 0.035, rng);
+  return window;
+}
+
+void BM_WindowSolve(benchmark::State& bench) {
+  const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+  const Window window = make_window();
+  WindowSolution solution;
+  for (auto _ : bench) {
+    solution = solve_window(window.problem, window.initial);
+    benchmark::DoNotOptimize(solution.final_cost);
+  }
+  bench.counters["correspondences"] = static_cast<double>(window.problem.planes.size() + window.problem.edges.size());
+  bench.counters["iterations"] = solution.iterations;
+  bench.counters["converged"] = solution.converged ? 1.0 : 0.0;
+}
+BENCHMARK(BM_WindowSolve)->Unit(benchmark::kMillisecond);
+
+void BM_WindowLinearize(benchmark::State& bench) {
+  const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+  const Window window = make_window();
+  const VariableLayout layout(window.initial);
+  for (auto _ : bench) benchmark::DoNotOptimize(linearize_window(window.problem, window.initial, layout, 0.1).cost);
+}
+BENCHMARK(BM_WindowLinearize)->Unit(benchmark::kMillisecond);
+
+void BM_MarginalizeOldest(benchmark::State& bench) {
+  const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+  Window window = make_window();
+  window.initial.pose_fixed.assign(5, false);  // a variable oldest pose: the Schur complement does work
+  for (auto _ : bench) benchmark::DoNotOptimize(marginalize_frame(window.problem, window.initial, 0, 0.1).residual.data());
+}
+BENCHMARK(BM_MarginalizeOldest)->Unit(benchmark::kMillisecond);
+
+}  // namespace
