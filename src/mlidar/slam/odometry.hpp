@@ -19,7 +19,7 @@
 // with sweep offsets), each pose error feeds the next velocity:
 // e_k = -(t_c / dt) (e_{k-1} - e_{k-2}), undamped at t_c = dt / 2 (a
 // growing period-2 oscillation beyond). At t_ref = t_c the shift vanishes
-// to first order (KISS-ICP likewise deskews to mid-sweep), and so does the
+// to first order, and so does the
 // bias of the first frames, mapped before any velocity is known; these are
 // deskewed again (and the map rebuilt) once frame 2 gives the first velocity.
 // The world frame is the base at the first stamp: at that point the poses and
