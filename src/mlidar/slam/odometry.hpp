@@ -51,7 +51,7 @@ struct OdometryConfig {
   /// (real BALM keyframes 45->46, a 21 deg turn). Above this mean |r| the yaw
   /// retries run, and a frame that stays above it is lost.
   double trusted_mean_residual_m = 0.2;
-  double lost_match_ratio = 0.3;      ///< below this after retries the frame is lost
+  double lost_match_ratio = 0.5;      ///< below this after retries the frame is lost
   std::vector<double> retry_yaw_deg = {15, -15, 30, -30, 45, -45, 60, -60};
 };
 
