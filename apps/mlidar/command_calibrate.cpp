@@ -184,9 +184,13 @@ Command register_calibrate(CLI::App& app) {
   auto_cmd->add_option("--stage", autocal->stage, "Stage to run: handeye")->capture_default_str();
   auto_cmd->add_option("--pair-stride", autocal->pair_stride, "Frames between the ends of a motion pair")->capture_default_str();
   auto_cmd->add_option("--out", autocal->out, "Run folder: extrinsics.yaml, calibration.json")->required();
+  const Command refine = add_calibrate_refine(*sub);
   auto planes_run = [planes] { return run_planes(*planes); };
   auto auto_run = [autocal] { return run_auto(*autocal); };
-  return {sub, [sub, planes_cmd, planes_run, auto_run] { return sub->got_subcommand(planes_cmd) ? planes_run() : auto_run(); }};
+  return {sub, [sub, planes_cmd, planes_run, auto_run, refine] {
+            if (sub->got_subcommand(refine.sub)) return refine.run();
+            return sub->got_subcommand(planes_cmd) ? planes_run() : auto_run();
+          }};
 }
 
 }  // namespace mlidar::cli

@@ -45,7 +45,8 @@ double rotation_deg_between(const SE3& a, const SE3& b) { return rad_to_deg(so3_
 Mat6 additive_translation_covariance(const Mat6& left, const Vec3& t) {
   Mat6 M = Mat6::Identity();
   M.topRightCorner<3, 3>() = -hat(t);
-  return M * left * M.transpose();
+  const Mat6 covariance = M * left * M.transpose();
+  return 0.5 * (covariance + covariance.transpose());  // exactly symmetric for the YAML writer/reader
 }
 
 double largest_sd(const Mat3& block) {
