@@ -29,11 +29,11 @@ struct PairRefineConfig {
   double ref_voxel_size = 0.05;         ///< m, the reference cloud is thinned to this before the k-d tree
   SurfaceConfig surface;
   IcpConfig icp;                        ///< from the guess and for the final candidates
-  IcpConfig search_icp{.levels = {{1.0, 2.0, 0.5}}, .max_iterations = 10, .max_points = 1000};  ///< short ICP per start
+  IcpConfig search_icp{.levels = {{1.0, 2.0, 0.5}}, .max_iterations = 8, .max_points = 500};  ///< short ICP per start
   CoarseSearchConfig search;
   double search_ref_voxel_size = 0.25;  ///< m, the short ICPs of the search use a reference thinned to this
   PairSearchMode search_mode = PairSearchMode::kAuto;
-  std::size_t search_finalists = 3;     ///< best distinct starts refined with the full ICP
+  std::size_t search_finalists = 2;     ///< best distinct starts refined with the full ICP
   double overlap_radius = 0.3;          ///< m, r of eq 3.13
   double fitness_voxel_size = 0.5;      ///< m, target thinning for the overlap fitness
   // Checks a result must pass to be trusted:
