@@ -1,5 +1,6 @@
 #include "mlidar/calib/point_to_plane_icp.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
