@@ -221,9 +221,13 @@ Command register_calibrate(CLI::App& app) {
                             ->capture_default_str();
   auto_cmd->add_option("--threads", autocal->threads, "Worker threads (0: all cores)")->capture_default_str();
   auto_cmd->add_option("--out", autocal->out, "Run folder: extrinsics.yaml, calibration.json")->required();
+  const Command refine = add_calibrate_refine(*sub);
   auto planes_run = [planes] { return run_planes(*planes); };
   auto auto_run = [autocal, stride] { return run_auto(*autocal, stride->count() > 0); };
-  return {sub, [sub, planes_cmd, planes_run, auto_run] { return sub->got_subcommand(planes_cmd) ? planes_run() : auto_run(); }};
+  return {sub, [sub, planes_cmd, planes_run, auto_run, refine] {
+            if (sub->got_subcommand(refine.sub)) return refine.run();
+            return sub->got_subcommand(planes_cmd) ? planes_run() : auto_run();
+          }};
 }
 
 }  // namespace mlidar::cli

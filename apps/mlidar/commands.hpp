@@ -18,6 +18,8 @@ Command register_convert(CLI::App& app);
 Command register_simulate(CLI::App& app);
 Command register_eval(CLI::App& app);
 Command register_calibrate(CLI::App& app);
+/// `calibrate refine` under the `calibrate` parent (command_calibrate_refine.cpp).
+Command add_calibrate_refine(CLI::App& calibrate);
 Command register_odometry(CLI::App& app);
 
 /// All sub-commands, in the order `mlidar --help` lists them.

@@ -1,0 +1,196 @@
+// `mlidar calibrate refine`: appearance-only refinement of one LiDAR pair from
+// single scans (issue 8, calib/pair_refine.hpp), from an extrinsics YAML or an
+// OpenCalib initial_extrinsic.txt guess.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/mlidar/commands.hpp"
+#include "mlidar/calib/pair_refine.hpp"
+#include "mlidar/core/conversions.hpp"
+#include "mlidar/core/error.hpp"
+#include "mlidar/io/atomic_file.hpp"
+#include "mlidar/io/cloud_file.hpp"
+#include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/opencalib.hpp"
+
+namespace mlidar::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RefineOptions {
+  std::string ref;
+  std::string target;
+  std::string init;
+  std::string out;
+  std::string report;
+  std::string ref_name = "ref";
+  std::string target_name = "target";
+  int target_id = 1;
+  std::string search = "auto";
+};
+
+bool is_yaml(const std::string& path) {
+  const std::string ext = fs::path(path).extension().string();
+  return ext == ".yaml" || ext == ".yml";
+}
+
+/// T_ref_target from the guess file: an extrinsics YAML naming the target (and
+/// the reference, or using it as base), or OpenCalib's initial_extrinsic.txt.
+SE3 read_initial_guess(const RefineOptions& options) {
+  if (!is_yaml(options.init)) {
+    const io::Extrinsics guesses = io::read_opencalib_initial_extrinsics(options.init);
+    const std::string device = "device_" + std::to_string(options.target_id);
+    const io::LidarExtrinsic* target = guesses.find(device);
+    if (target == nullptr)
+      throw InputError(options.init, "device_id", "no device " + std::to_string(options.target_id) + " (pick it with --target-id)");
+    return target->T_base_lidar;
+  }
+  const io::Extrinsics extrinsics = io::read_extrinsics(options.init);
+  const io::LidarExtrinsic* target = extrinsics.find(options.target_name);
+  if (target == nullptr)
+    throw InputError(options.init, "lidars." + options.target_name, "missing; name the target LiDAR with --target-name");
+  const io::LidarExtrinsic* ref = extrinsics.find(options.ref_name);
+  if (ref == nullptr && extrinsics.base != options.ref_name)
+    throw InputError(options.init, "lidars." + options.ref_name,
+                     "missing; the file must name the reference LiDAR (--ref-name) or use it as base");
+  return ref == nullptr ? target->T_base_lidar : ref->T_base_lidar.inverse() * target->T_base_lidar;
+}
+
+calib::PairSearchMode search_mode(const std::string& text) {
+  if (text == "auto") return calib::PairSearchMode::kAuto;
+  if (text == "always") return calib::PairSearchMode::kAlways;
+  return calib::PairSearchMode::kNever;  // CLI11 checks the choice
+}
+
+nlohmann::json pose_json(const SE3& T) {
+  const Vec3 rpy = rpy_deg_from_quat(T.rotation());
+  const Vec4 q = quat_to_wxyz(T.rotation());
+  return {{"translation", {T.translation().x(), T.translation().y(), T.translation().z()}},
+          {"quaternion_wxyz", {q(0), q(1), q(2), q(3)}},
+          {"rpy_deg", {rpy.x(), rpy.y(), rpy.z()}}};
+}
+
+std::vector<double> row_major(const Mat6& m) {
+  std::vector<double> values;
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) values.push_back(m(r, c));
+  return values;
+}
+
+nlohmann::json report_json(const calib::PairRefineResult& r, double overlap_radius, double seconds) {
+  nlohmann::json starts = nlohmann::json::array();
+  for (const auto& s : r.starts)
+    starts.push_back({{"label", s.label}, {"start", pose_json(s.T_start)}, {"after", pose_json(s.T_after)},
+                      {"overlap", s.overlap}, {"rmse_m", s.rmse}});
+  return {{"verdict", std::string(calib::to_string(r.verdict))},
+          {"reasons", r.reasons},
+          {"searched", r.searched},
+          {"chosen_start", r.chosen_start},
+          {"starts", starts},
+          {"T_ref_target_initial", pose_json(r.T_init)},
+          {"T_ref_target", pose_json(r.T_ref_target)},
+          {"covariance", row_major(r.covariance)},
+          {"information", row_major(r.information)},
+          {"rotation_sd_deg", r.rotation_sd_deg},
+          {"translation_sd_m", r.translation_sd_m},
+          {"rmse_m", r.rmse},
+          {"inlier_ratio", r.inlier_ratio},
+          {"overlap", {{"radius_m", overlap_radius},
+                       {"target_fraction", r.overlap.fraction_b},
+                       {"ref_fraction", r.overlap.fraction_a},
+                       {"omega", r.overlap.omega()}}},
+          {"iterations", r.iterations},
+          {"seconds", seconds}};
+}
+
+void print_table(const calib::PairRefineResult& r, double seconds) {
+  const auto row = [](const char* name, const SE3& T) {
+    const Vec3 rpy = rpy_deg_from_quat(T.rotation());
+    const Vec3& t = T.translation();
+    std::printf("%-8s %9.3f %9.3f %9.3f %9.4f %9.4f %9.4f\n", name, rpy.x(), rpy.y(), rpy.z(), t.x(), t.y(), t.z());
+  };
+  std::printf("%-8s %9s %9s %9s %9s %9s %9s\n", "", "roll", "pitch", "yaw [deg]", "x", "y", "z [m]");
+  row("initial", r.T_init);
+  row("refined", r.T_ref_target);
+  const SE3 change = r.T_init.inverse() * r.T_ref_target;
+  std::printf("change %.3f deg, %.4f m; rmse %.4f m; overlap %.2f (omega %.3f); sd %.3f deg, %.4f m\n",
+              rad_to_deg(so3_log(change.rotation()).norm()), (r.T_ref_target.translation() - r.T_init.translation()).norm(),
+              r.rmse, r.overlap.fraction_b, r.overlap.omega(), r.rotation_sd_deg, r.translation_sd_m);
+  std::printf("searched: %s", r.searched ? "yes" : "no");
+  if (r.searched) std::printf(" (%zu starts, answer from '%s')", r.starts.size(), r.chosen_start.c_str());
+  std::printf("; verdict: %s; %.2f s\n", std::string(calib::to_string(r.verdict)).c_str(), seconds);
+  for (const std::string& reason : r.reasons) std::printf("  reason: %s\n", reason.c_str());
+}
+
+int run_refine(const RefineOptions& options) {
+  if (options.ref_name == options.target_name) throw UsageError("--ref-name and --target-name must differ");
+  const SE3 T_init = read_initial_guess(options);
+  const Scan ref = io::to_scan(io::read_cloud(options.ref).table, options.ref);
+  const Scan target = io::to_scan(io::read_cloud(options.target).table, options.target);
+  calib::PairRefineConfig config;
+  config.search_mode = search_mode(options.search);
+
+  const auto start = std::chrono::steady_clock::now();
+  const calib::PairRefineResult result = calib::refine_pair(ref.points, target.points, T_init, config);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  const bool trusted = result.verdict != calib::PairVerdict::kNotConverged;
+  if (trusted) {
+    io::Extrinsics extrinsics;
+    extrinsics.base = options.ref_name;
+    extrinsics.lidars = {{options.ref_name, SE3(), std::nullopt},
+                         {options.target_name, result.T_ref_target, result.covariance}};
+    io::write_extrinsics(options.out, extrinsics);
+  }
+  if (!options.report.empty()) {
+    const std::string text = report_json(result, config.overlap_radius, seconds).dump(2);
+    io::write_atomically(options.report, [&](std::ostream& out) { out << text << '\n'; });
+  }
+  print_table(result, seconds);
+  if (!trusted) {
+    std::cerr << "error: the refinement did not converge; " << options.out << " was not written"
+              << (options.report.empty() ? "" : " (see the report)") << '\n';
+    return static_cast<int>(ExitCode::kUntrusted);
+  }
+  std::cout << "wrote " << options.out << '\n';
+  return 0;
+}
+
+}  // namespace
+
+Command add_calibrate_refine(CLI::App& calibrate) {
+  auto options = std::make_shared<RefineOptions>();
+  CLI::App* cmd = calibrate.add_subcommand(
+      "refine", "Appearance-only refinement of one LiDAR pair from single scans (point-to-plane ICP, search when far off)");
+  cmd->add_option("--ref", options->ref, "Reference LiDAR scan (PCD, PLY, KITTI .bin)")->required();
+  cmd->add_option("--target", options->target, "Target LiDAR scan")->required();
+  cmd->add_option("--init", options->init,
+                  "Initial guess of T_ref_target: an extrinsics YAML (.yaml/.yml) naming the target (--target-name) "
+                  "and the reference or using it as base; or OpenCalib initial_extrinsic.txt (device 0 = reference, "
+                  "the target is --target-id)")
+      ->required();
+  cmd->add_option("--out", options->out, "Output extrinsics YAML (reference identity, target with covariance); "
+                                         "written only when the refinement converged")
+      ->required();
+  cmd->add_option("--report", options->report, "JSON report: verdict, reasons, starts tried, overlap, covariance");
+  cmd->add_option("--ref-name", options->ref_name, "Reference LiDAR name in --init YAML and --out")->capture_default_str();
+  cmd->add_option("--target-name", options->target_name, "Target LiDAR name in --init YAML and --out")->capture_default_str();
+  cmd->add_option("--target-id", options->target_id,
+                  "OpenCalib device_id of the target in initial_extrinsic.txt (lidar_cloud_path.txt maps ids to clouds)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--search", options->search,
+                  "Multi-start search: auto (when the registration from the guess is poor), always, never")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "always", "never"}));
+  return {cmd, [options] { return run_refine(*options); }};
+}
+
+}  // namespace mlidar::cli
