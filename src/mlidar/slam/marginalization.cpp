@@ -1,0 +1,118 @@
+#include "mlidar/slam/marginalization.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "mlidar/slam/window_linearize.hpp"
+
+namespace mlidar::slam {
+namespace {
+
+bool touches(const std::vector<VariableId>& ids, VariableId id) { return std::find(ids.begin(), ids.end(), id) != ids.end(); }
+
+/// The variables of the terms on `frame`: the pose, the extrinsics its correspondences use, the prior's.
+std::vector<VariableId> involved_variables(const WindowProblem& terms, const WindowState& state, int frame) {
+  std::vector<VariableId> ids{{VariableId::Kind::kPose, frame}};
+  const auto add_lidar = [&](int lidar) {
+    const VariableId id{VariableId::Kind::kExtrinsic, lidar};
+    if (!touches(ids, id)) ids.push_back(id);
+  };
+  for (const PlaneCorrespondence& c : terms.planes) add_lidar(c.lidar);
+  for (const EdgeCorrespondence& c : terms.edges) add_lidar(c.lidar);
+  for (const VariableId& id : terms.prior.variables)
+    if (!touches(ids, id)) ids.push_back(id);
+  std::erase_if(ids, [&](const VariableId& id) { return state.fixed(id); });
+  return ids;
+}
+
+/// `state` with every block outside `ids` held fixed, so its layout spans `ids` only.
+WindowState restricted_to(const WindowState& state, const std::vector<VariableId>& ids) {
+  WindowState local = state;
+  local.pose_fixed.assign(state.pose_fixed.size(), true);
+  local.extrinsic_fixed.assign(state.extrinsic_fixed.size(), true);
+  for (const VariableId& id : ids) {
+    auto& flags = id.kind == VariableId::Kind::kPose ? local.pose_fixed : local.extrinsic_fixed;
+    flags[static_cast<std::size_t>(id.index)] = false;
+  }
+  return local;
+}
+
+}  // namespace
+
+SchurComplement schur_complement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, const std::vector<int>& marginalized) {
+  SchurComplement out;
+  for (int k = 0; k < static_cast<int>(H.rows()); ++k)
+    if (std::find(marginalized.begin(), marginalized.end(), k) == marginalized.end()) out.kept_columns.push_back(k);
+  const Eigen::MatrixXd H_mm = H(marginalized, marginalized);
+  const Eigen::MatrixXd H_rm = H(out.kept_columns, marginalized);
+  const Eigen::LDLT<Eigen::MatrixXd> H_mm_ldlt(H_mm);
+  // Eq 4.41.
+  out.H = H(out.kept_columns, out.kept_columns) - H_rm * H_mm_ldlt.solve(H_rm.transpose());
+  out.g = g(out.kept_columns) - H_rm * H_mm_ldlt.solve(g(marginalized));
+  out.H = 0.5 * (out.H + out.H.transpose());
+  return out;
+}
+
+void factor_prior(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd& jacobian, Eigen::VectorXd& residual) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(H);
+  const Eigen::VectorXd& values = eigen.eigenvalues();
+  const double cutoff = 1e-12 * std::max(values.size() > 0 ? values.maxCoeff() : 0.0, 0.0);
+  std::vector<int> kept;
+  for (int k = 0; k < static_cast<int>(values.size()); ++k)
+    if (values(k) > cutoff && values(k) > 0.0) kept.push_back(k);
+  // Eq 4.43-4.44: J* = Psi^1/2 P^T, r* = Psi^-1/2 P^T g.
+  const Eigen::MatrixXd P = eigen.eigenvectors()(Eigen::all, kept);
+  const Eigen::VectorXd psi = values(kept);
+  jacobian = psi.cwiseSqrt().asDiagonal() * P.transpose();
+  residual = psi.cwiseSqrt().cwiseInverse().asDiagonal() * (P.transpose() * g);
+}
+
+LinearPrior marginalize_frame(const WindowProblem& problem, const WindowState& state, int frame, double huber_delta_m) {
+  check_problem(problem, state);
+  WindowProblem terms;
+  std::copy_if(problem.planes.begin(), problem.planes.end(), std::back_inserter(terms.planes),
+               [frame](const PlaneCorrespondence& c) { return c.frame == frame; });
+  std::copy_if(problem.edges.begin(), problem.edges.end(), std::back_inserter(terms.edges),
+               [frame](const EdgeCorrespondence& c) { return c.frame == frame; });
+  terms.prior = problem.prior;
+  const std::vector<VariableId> ids = involved_variables(terms, state, frame);
+  const WindowState local = restricted_to(state, ids);
+  const VariableLayout layout(local);
+  const WindowLinearSystem system = linearize_window(terms, local, layout, huber_delta_m);
+  const int pose_offset = layout.pose_offset.at(static_cast<std::size_t>(frame));
+  std::vector<int> marginalized;
+  for (int k = 0; pose_offset >= 0 && k < 6; ++k) marginalized.push_back(pose_offset + k);
+  const SchurComplement reduced = schur_complement(system.H, system.g, marginalized);
+
+  LinearPrior prior;
+  for (const VariableId& id : ids) {  // layout order: poses ascending, then extrinsics; ids is a permutation of it
+    if (id.kind == VariableId::Kind::kPose && id.index == frame) continue;
+    prior.variables.push_back(id);
+  }
+  std::sort(prior.variables.begin(), prior.variables.end(),
+            [&](const VariableId& a, const VariableId& b) { return layout.offset(a) < layout.offset(b); });
+  for (const VariableId& id : prior.variables) prior.linearization_points.push_back(state.value(id));
+  factor_prior(reduced.H, reduced.g, prior.jacobian, prior.residual);
+  if (prior.jacobian.rows() == 0) prior = LinearPrior{};
+  return prior;
+}
+
+void shift_window(WindowProblem& problem, WindowState& state, LinearPrior prior, const SE3& T_world_base_new) {
+  for (VariableId& id : prior.variables) {
+    if (id.kind != VariableId::Kind::kPose) continue;
+    if (id.index == 0) throw std::invalid_argument("shift_window: the prior still holds pose 0; marginalize it first");
+    --id.index;
+  }
+  state.T_world_base.erase(state.T_world_base.begin());
+  state.pose_fixed.erase(state.pose_fixed.begin());
+  state.T_world_base.push_back(T_world_base_new);
+  state.pose_fixed.push_back(false);
+  problem.planes.clear();
+  problem.edges.clear();
+  problem.prior = std::move(prior);
+}
+
+}  // namespace mlidar::slam

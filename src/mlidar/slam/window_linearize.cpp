@@ -1,0 +1,173 @@
+#include "mlidar/slam/window_linearize.hpp"
+
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+namespace mlidar::slam {
+namespace {
+
+using Mat12 = Eigen::Matrix<double, 12, 12>;
+
+/// One row s = n^T q + offset with its pose and extrinsic gradients.
+void add_row(ResidualRows& rows, const Vec3& n, double offset, const Vec3& q, const Vec3& y, const Mat3& R_world_base) {
+  const auto k = static_cast<std::size_t>(rows.count++);
+  rows.directions[k] = n;
+  rows.values[k] = n.dot(q) + offset;
+  const Vec3 v = R_world_base.transpose() * n;
+  rows.gradients[k] << n, q.cross(n), v, y.cross(v);
+}
+
+/// Sums of w J^T J and w J^T r per (frame, lidar) pair, 12 columns [pose, extrinsic].
+struct PairSums {
+  std::vector<Mat12> H;  // lower triangle only until scattered
+  std::vector<Vec12> g;
+  double cost = 0.0;
+
+  explicit PairSums(std::size_t pairs) : H(pairs, Mat12::Zero()), g(pairs, Vec12::Zero()) {}
+  PairSums& operator+=(const PairSums& o) {
+    for (std::size_t k = 0; k < H.size(); ++k) {
+      H[k] += o.H[k];
+      g[k] += o.g[k];
+    }
+    cost += o.cost;
+    return *this;
+  }
+};
+
+/// Visits every correspondence's rows (in parallel) and folds them with `fold(rows, pair, sums)`.
+template <typename Fold>
+PairSums reduce_rows(const WindowProblem& problem, const WindowState& state, std::size_t pairs, const Fold& fold) {
+  const std::size_t lidars = state.T_base_lidar.size();
+  const std::size_t total = problem.planes.size() + problem.edges.size();
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, total, 512), PairSums(pairs),
+      [&](const tbb::blocked_range<std::size_t>& range, PairSums sums) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const bool plane = i < problem.planes.size();
+          const int frame = plane ? problem.planes[i].frame : problem.edges[i - problem.planes.size()].frame;
+          const int lidar = plane ? problem.planes[i].lidar : problem.edges[i - problem.planes.size()].lidar;
+          const SE3& T_world_base = state.T_world_base[static_cast<std::size_t>(frame)];
+          const SE3& T_base_lidar = state.T_base_lidar[static_cast<std::size_t>(lidar)];
+          const ResidualRows rows = plane ? plane_rows(problem.planes[i], T_world_base, T_base_lidar)
+                                          : edge_rows(problem.edges[i - problem.planes.size()], T_world_base, T_base_lidar);
+          fold(rows, static_cast<std::size_t>(frame) * lidars + static_cast<std::size_t>(lidar), sums);
+        }
+        return sums;
+      },
+      [](PairSums a, const PairSums& b) { return a += b; });
+}
+
+/// Adds a 12-column pair block into the layout's system (fixed blocks dropped).
+void scatter_pair(const Mat12& H_pair, const Vec12& g_pair, int pose_offset, int extrinsic_offset, WindowLinearSystem& system) {
+  const std::array<int, 2> offsets{pose_offset, extrinsic_offset};
+  for (std::size_t a = 0; a < 2; ++a) {
+    if (offsets[a] < 0) continue;
+    system.g.segment<6>(offsets[a]) += g_pair.segment<6>(static_cast<Eigen::Index>(6 * a));
+    for (std::size_t b = 0; b < 2; ++b)
+      if (offsets[b] >= 0)
+        system.H.block<6, 6>(offsets[a], offsets[b]) +=
+            H_pair.block<6, 6>(static_cast<Eigen::Index>(6 * a), static_cast<Eigen::Index>(6 * b));
+  }
+}
+
+void add_prior(const LinearPrior& prior, const WindowState& state, const VariableLayout& layout, WindowLinearSystem& system) {
+  if (prior.variables.empty()) return;
+  const Eigen::VectorXd r = prior_residual(prior, state);
+  system.cost += 0.5 * r.squaredNorm();
+  for (std::size_t a = 0; a < prior.variables.size(); ++a) {
+    const int oa = layout.offset(prior.variables[a]);
+    if (oa < 0) continue;
+    const auto Ja = prior.jacobian.middleCols<6>(static_cast<Eigen::Index>(6 * a));
+    system.g.segment<6>(oa) += Ja.transpose() * r;
+    for (std::size_t b = 0; b < prior.variables.size(); ++b) {
+      const int ob = layout.offset(prior.variables[b]);
+      if (ob >= 0) system.H.block<6, 6>(oa, ob) += Ja.transpose() * prior.jacobian.middleCols<6>(static_cast<Eigen::Index>(6 * b));
+    }
+  }
+}
+
+}  // namespace
+
+Vec3 ResidualRows::residual() const {
+  Vec3 r = Vec3::Zero();
+  for (std::size_t k = 0; k < static_cast<std::size_t>(count); ++k) r += values[k] * directions[k];
+  return r;
+}
+
+double ResidualRows::squared_norm() const {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(count); ++k) sum += values[k] * values[k];
+  return sum;
+}
+
+ResidualRows plane_rows(const PlaneCorrespondence& c, const SE3& T_world_base, const SE3& T_base_lidar) {
+  const Vec3 y = T_base_lidar * c.point_lidar;
+  const Vec3 q = T_world_base * y;
+  ResidualRows rows;
+  add_row(rows, c.plane_world.normal, c.plane_world.offset, q, y, T_world_base.rotation_matrix());
+  return rows;
+}
+
+ResidualRows edge_rows(const EdgeCorrespondence& c, const SE3& T_world_base, const SE3& T_base_lidar) {
+  const Vec3 y = T_base_lidar * c.point_lidar;
+  const Vec3 q = T_world_base * y;
+  const Vec3& u = c.line_direction_world;
+  const Vec3 n1 = u.unitOrthogonal();
+  const Vec3 n2 = u.cross(n1).normalized();
+  const Mat3 R = T_world_base.rotation_matrix();
+  ResidualRows rows;
+  add_row(rows, n1, -n1.dot(c.line_point_world), q, y, R);
+  add_row(rows, n2, -n2.dot(c.line_point_world), q, y, R);
+  return rows;
+}
+
+double huber_loss(double squared_norm, double delta) {
+  return squared_norm <= delta * delta ? squared_norm : 2.0 * delta * std::sqrt(squared_norm) - delta * delta;
+}
+
+WindowLinearSystem linearize_window(const WindowProblem& problem, const WindowState& state, const VariableLayout& layout,
+                                    double huber_delta, PriorTerm prior) {
+  check_problem(problem, state);
+  const std::size_t lidars = state.T_base_lidar.size();
+  const std::size_t pairs = state.T_world_base.size() * lidars;
+  PairSums sums = reduce_rows(problem, state, pairs, [huber_delta](const ResidualRows& rows, std::size_t pair, PairSums& s) {
+    const double squared = rows.squared_norm();
+    const double weight = huber_weight(std::sqrt(squared), huber_delta);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(rows.count); ++k) {
+      s.H[pair].selfadjointView<Eigen::Lower>().rankUpdate(rows.gradients[k], weight);
+      s.g[pair].noalias() += weight * rows.values[k] * rows.gradients[k];
+    }
+    s.cost += 0.5 * huber_loss(squared, huber_delta);
+  });
+  WindowLinearSystem system;
+  system.H = Eigen::MatrixXd::Zero(layout.size, layout.size);
+  system.g = Eigen::VectorXd::Zero(layout.size);
+  system.cost = sums.cost;
+  for (std::size_t pair = 0; pair < pairs; ++pair) {
+    const Mat12 H_pair = sums.H[pair].selfadjointView<Eigen::Lower>();
+    scatter_pair(H_pair, sums.g[pair], layout.pose_offset[pair / lidars], layout.extrinsic_offset[pair % lidars], system);
+  }
+  if (prior == PriorTerm::kInclude) add_prior(problem.prior, state, layout, system);
+  return system;
+}
+
+double window_cost(const WindowProblem& problem, const WindowState& state, double huber_delta) {
+  check_problem(problem, state);
+  const PairSums sums = reduce_rows(problem, state, 0, [huber_delta](const ResidualRows& rows, std::size_t, PairSums& s) {
+    s.cost += 0.5 * huber_loss(rows.squared_norm(), huber_delta);
+  });
+  double cost = sums.cost;
+  if (!problem.prior.variables.empty()) cost += 0.5 * prior_residual(problem.prior, state).squaredNorm();
+  return cost;
+}
+
+Eigen::VectorXd prior_residual(const LinearPrior& prior, const WindowState& state) {
+  Eigen::VectorXd dx(static_cast<Eigen::Index>(6 * prior.variables.size()));
+  for (std::size_t k = 0; k < prior.variables.size(); ++k)
+    dx.segment<6>(static_cast<Eigen::Index>(6 * k)) = (state.value(prior.variables[k]) * prior.linearization_points[k].inverse()).log();
+  return prior.residual + prior.jacobian * dx;
+}
+
+}  // namespace mlidar::slam
