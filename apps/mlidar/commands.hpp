@@ -19,6 +19,7 @@ Command register_simulate(CLI::App& app);
 Command register_eval(CLI::App& app);
 Command register_calibrate(CLI::App& app);
 Command register_odometry(CLI::App& app);
+Command register_slam(CLI::App& app);
 
 /// All sub-commands, in the order `mlidar --help` lists them.
 std::vector<Command> register_commands(CLI::App& app);
