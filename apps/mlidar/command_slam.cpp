@@ -15,6 +15,9 @@ void print_lidar(const pipelines::SlamLidarReport& lidar) {
   std::cout << "  " << lidar.name << ": " << pipelines::to_string(lidar.role);
   if (lidar.initialized_frame) std::cout << ", initialized at frame " << *lidar.initialized_frame;
   if (lidar.initialization.planar_motion) std::cout << " (planar motion: translation along the rotation axis fixed to 0)";
+  const auto& sv = lidar.initialization.singular_values;
+  if (lidar.role == pipelines::LidarRole::initializing && lidar.initialization.pairs_stored >= 10 && sv[2] < 0.1 * sv[1])
+    std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
   if (lidar.converged_frame) std::cout << ", converged at frame " << *lidar.converged_frame;
   if (lidar.restarts > 0) std::cout << ", " << lidar.restarts << " re-calibration(s) after an extrinsic shock";
   if (lidar.missing_frames > 0) std::cout << ", " << lidar.missing_frames << " frame(s) without a scan";
@@ -40,7 +43,7 @@ Command register_slam(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("slam", "Multi-LiDAR odometry with online extrinsic calibration (M-LOAM back end)");
   sub->add_option("--dataset", job->dataset, "Dataset folder (dataset.yaml, times.txt, scans/)")->required();
   sub->add_option("--config", job->config, "Back-end parameters (config/mloam.yaml documents every key; default Table 4.2)");
-  sub->add_option("--calibrate", job->calibrate, "online: calibrate every LiDAR online; fixed: the dataset's extrinsics as given")
+  sub->add_option("--calibrate", job->calibrate, "online: initialize and calibrate every LiDAR online; refine: calibrate from the dataset's extrinsics; fixed: use them as given")
       ->capture_default_str();
   sub->add_option("--threads", job->threads, "Worker threads (0: all cores)")->capture_default_str();
   sub->add_option("--out", job->out, "Run folder: trajectory.tum/.kitti, extrinsics.yaml, map.ply, metrics.json")->required();

@@ -101,13 +101,13 @@ SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> li
       shock_(lidars.size(), config_.shock) {
   if (lidars.empty()) throw std::invalid_argument("SlamEstimator: no LiDARs");
   for (std::size_t j = 0; j < lidars.size(); ++j) {
-    const bool trusted = j == 0 || source == ExtrinsicSource::fixed;
-    const SE3 T_start = trusted ? (j == 0 ? SE3::identity() : lidars[j].T_base_lidar) : SE3::identity();
-    tracks_.push_back(std::make_unique<Track>(with_extrinsic(lidars[j], T_start), config_.initialization));
+    const bool given = j > 0 && source != ExtrinsicSource::online;
+    tracks_.push_back(std::make_unique<Track>(with_extrinsic(lidars[j], given ? lidars[j].T_base_lidar : SE3::identity()), config_.initialization));
     Track& track = *tracks_.back();
     track.report.name = track.setup.name;
-    track.role = trusted ? LidarRole::trusted : LidarRole::initializing;
-    if (!trusted) track.own = std::make_unique<slam::Odometry>(config_.odometry, std::vector{with_extrinsic(track.setup, SE3::identity())});
+    if (j == 0 || source == ExtrinsicSource::fixed) track.role = LidarRole::trusted;
+    else if (source == ExtrinsicSource::refine) track.role = LidarRole::calibrating;
+    else track.own = std::make_unique<slam::Odometry>(config_.odometry, std::vector{with_extrinsic(track.setup, SE3::identity())});
   }
   odometry_ = std::make_unique<slam::Odometry>(config_.odometry, trusted_setups());
 }

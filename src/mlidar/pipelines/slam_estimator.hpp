@@ -39,7 +39,11 @@
 
 namespace mlidar::pipelines {
 
-enum class ExtrinsicSource { online, fixed };
+/// online: every auxiliary LiDAR is initialized (hand-eye) and calibrated;
+/// refine: calibrated starting from the given extrinsics (no hand-eye: e.g.
+/// planar motion, where the hand-eye cannot fix the rotation about the
+/// common axis); fixed: the given extrinsics are used as they are.
+enum class ExtrinsicSource { online, refine, fixed };
 
 /// Where a LiDAR stands. The base is always trusted.
 enum class LidarRole { initializing, calibrating, trusted };
@@ -92,8 +96,7 @@ struct SlamLidarReport {
 
 class SlamEstimator {
  public:
-  /// `lidars`: base first. In fixed mode their extrinsics are used as given;
-  /// online, only the base's (identity) is. Throws std::invalid_argument for no LiDARs.
+  /// `lidars`: base first. Online, only the base's extrinsic (identity) is used. Throws std::invalid_argument for no LiDARs.
   SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source);
   ~SlamEstimator();
   SlamEstimator(const SlamEstimator&) = delete;

@@ -71,7 +71,8 @@ bool SlamJobSummary::all_converged() const {
 }
 
 SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, int)>& progress) {
-  if (job.calibrate != "online" && job.calibrate != "fixed") throw UsageError("--calibrate must be online or fixed, not '" + job.calibrate + "'");
+  if (job.calibrate != "online" && job.calibrate != "refine" && job.calibrate != "fixed")
+    throw UsageError("--calibrate must be online, refine or fixed, not '" + job.calibrate + "'");
   if (job.threads < 0) throw UsageError("--threads must be >= 0");
   if (job.dataset.empty()) throw UsageError("--dataset DIR is required");
   const SlamConfig config = job.config.empty() ? SlamConfig{} : read_slam_config(job.config);
@@ -79,7 +80,9 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
   std::unique_ptr<tbb::global_control> threads;
   if (job.threads > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
 
-  const ExtrinsicSource source = job.calibrate == "online" ? ExtrinsicSource::online : ExtrinsicSource::fixed;
+  const ExtrinsicSource source = job.calibrate == "online"   ? ExtrinsicSource::online
+                                : job.calibrate == "refine" ? ExtrinsicSource::refine
+                                                            : ExtrinsicSource::fixed;
   SlamEstimator estimator(config, in.lidars, source);
   std::vector<SlamFrame> frames;
   std::vector<double> load_seconds;

@@ -4,7 +4,8 @@
 // its first LiDAR when the base names none), then by name, so the order the
 // dataset lists them in does not matter. Online (default), the dataset's
 // extrinsics are not used: every auxiliary LiDAR is initialized and
-// calibrated online; fixed uses them as given. A LiDAR's scan folder may
+// calibrated online; refine calibrates starting from them (no hand-eye:
+// the way under planar motion); fixed uses them as given. A LiDAR's scan folder may
 // lack some frames (see frame_clouds: files named by frame number); such a
 // LiDAR is reported and the others carry on. Writes the run folder, created
 // at the end, every file atomically:
@@ -25,7 +26,7 @@ namespace mlidar::pipelines {
 struct SlamJob {
   std::filesystem::path dataset;
   std::filesystem::path config;       ///< mloam.yaml, or empty for the defaults (Table 4.2)
-  std::string calibrate = "online";   ///< "online" or "fixed"
+  std::string calibrate = "online";   ///< "online", "refine" or "fixed"
   int threads = 0;                    ///< 0 = TBB's default
   std::filesystem::path out;
 };
