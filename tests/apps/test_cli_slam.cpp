@@ -4,8 +4,11 @@
 // trajectory tracks the ground truth, and listing the LiDARs in another order
 // changes nothing; fixed mode with the true extrinsics is the odometry; a
 // LiDAR with missing scans is reported and the run carries on; a bad config
-// key exits 3 and writes nothing.
+// key exits 3 and writes nothing; an injected extrinsic shock (Table 4.6) is
+// detected within a few frames.
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -158,6 +161,52 @@ TEST(CliSlam, FixedModeIsTheOdometryAndMissingScansAreReported) {
   EXPECT_TRUE(metrics["per_frame"][12]["lidars"]["right"]["scan_missing"].get<bool>());
   EXPECT_FALSE(metrics["per_frame"][15]["lidars"]["right"]["scan_missing"].get<bool>());
   EXPECT_LT(ate_rmse(gt, io::read_tum(gap_run / "trajectory.tum")), kMaxAteM);
+}
+
+/// Moves a LiDAR's mounting from frame `first` on: its points p become Delta^-1 p (T_base_lidar -> T_base_lidar Delta).
+void shift_mounting(const fs::path& folder, int first, int frames, const SE3& Delta) {
+  const SE3 T_new_old = Delta.inverse();
+  for (int k = first; k < frames; ++k) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "%06d.pcd", k);
+    io::CloudFile cloud = io::read_cloud(folder / name);
+    std::array<io::FieldColumn*, 3> xyz{cloud.table.find("x"), cloud.table.find("y"), cloud.table.find("z")};
+    for (const auto* column : xyz) ASSERT_TRUE(column != nullptr && column->type == io::ScalarType::kF32);
+    for (std::size_t i = 0; i < cloud.table.num_points; ++i) {
+      std::array<float, 3> p{};
+      for (std::size_t a = 0; a < 3; ++a) std::memcpy(&p[a], xyz[a]->data.data() + i * sizeof(float), sizeof(float));
+      const Vec3 moved = T_new_old * Vec3(p[0], p[1], p[2]);
+      for (std::size_t a = 0; a < 3; ++a) {
+        const auto value = static_cast<float>(moved(static_cast<Eigen::Index>(a)));
+        std::memcpy(xyz[a]->data.data() + i * sizeof(float), &value, sizeof(float));
+      }
+    }
+    fs::remove(folder / name);
+    io::write_cloud(folder / name, cloud);
+  }
+}
+
+TEST(CliSlam, ExtrinsicShockIsDetectedAtItsFrame) {
+  // Thesis Table 4.6's shock: 10 deg about each axis and 0.1 m along each, on the right LiDAR from frame 30.
+  constexpr int kShockFrames = 50;
+  constexpr int kShockFrame = 30;
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate(dir, kShockFrames, "0,0");
+  const fs::path truth = dataset_variant(sim, dir / "truth", false, true);
+  const double deg = 0.017453292519943295;
+  Vec6 delta;
+  delta << 0.1, 0.1, 0.1, 10 * deg, 10 * deg, 10 * deg;
+  shift_mounting(sim / "scans" / "right", kShockFrame, kShockFrames, SE3::exp(delta));
+  const fs::path run = dir / "run";
+  const CliResult result = run_cli("slam --dataset " + quoted(truth.string()) + " --calibrate fixed --out " + quoted(run.string()));
+  ASSERT_LE(result.exit_code, 1) << result.output;
+  const auto metrics = read_metrics(run);
+  EXPECT_TRUE(metrics["per_lidar"]["left"]["shock_frames"].empty()) << metrics["per_lidar"]["left"]["shock_frames"];
+  const auto& shocks = metrics["per_lidar"]["right"]["shock_frames"];
+  ASSERT_FALSE(shocks.empty());
+  // The trigger needs `consecutive` (5) high frames in a row.
+  EXPECT_GE(shocks.front().get<int>(), kShockFrame);
+  EXPECT_LE(shocks.front().get<int>(), kShockFrame + 8);
 }
 
 TEST(CliSlam, BadConfigKeyExitsThreeAndWritesNothing) {
