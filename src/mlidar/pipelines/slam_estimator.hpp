@@ -5,7 +5,7 @@
 //     features together: the pure-odometry mode, eq 4.22); it gives
 //     T_world_base. Start: {base} (online) or every LiDAR (fixed).
 //   - initialization of each untrusted LiDAR j (eq 4.15-4.18): its own
-//     odometry (identity extrinsic) gives B_k, the trusted poses give A_k, for
+//     odometry gives B_k, the trusted poses give A_k, for
 //     frames 5 apart (one overlapping pair per frame), into
 //     calib::OnlineHandEye until it is ready
 //     (under planar motion t along the rotation axis is fixed to 0, flagged);
@@ -96,7 +96,9 @@ struct SlamLidarReport {
 
 class SlamEstimator {
  public:
-  /// `lidars`: base first. Online, only the base's extrinsic (identity) is used. Throws std::invalid_argument for no LiDARs.
+  /// `lidars`: base first. Online, their extrinsics serve only as the up
+  /// direction of each LiDAR's own odometry (their rotation; give identity
+  /// when unknown); the estimate never starts from them. Throws std::invalid_argument for no LiDARs.
   SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source);
   ~SlamEstimator();
   SlamEstimator(const SlamEstimator&) = delete;

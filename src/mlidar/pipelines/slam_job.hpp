@@ -2,9 +2,10 @@
 // `mlidar slam`: the M-LOAM estimator (slam_estimator.hpp) over a dataset
 // folder (io/dataset.hpp). The LiDARs run base first (the dataset's base, or
 // its first LiDAR when the base names none), then by name, so the order the
-// dataset lists them in does not matter. Online (default), the dataset's
-// extrinsics are not used: every auxiliary LiDAR is initialized and
-// calibrated online; refine calibrates starting from them (no hand-eye:
+// dataset lists them in does not matter. Online (default), the estimate does
+// not start from the dataset's extrinsics (their rotations only tell each
+// LiDAR's own odometry which way is up): every auxiliary LiDAR is
+// initialized and calibrated online; refine calibrates starting from them (no hand-eye:
 // the way under planar motion); fixed uses them as given. A LiDAR's scan folder may
 // lack some frames (see frame_clouds: files named by frame number); such a
 // LiDAR is reported and the others carry on. Writes the run folder, created
