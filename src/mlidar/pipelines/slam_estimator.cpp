@@ -1,5 +1,6 @@
 #include "mlidar/pipelines/slam_estimator.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -7,7 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "mlidar/slam/window_solver.hpp"
+#include "mlidar/slam/calibration_window.hpp"
 
 namespace mlidar::pipelines {
 namespace {
@@ -18,7 +19,7 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 /// Correspondence gates (m) of the calibration's re-matching passes: the
 /// hand-eye start may be a degree and centimetres off (0.5 m at 30 m range),
 /// the second pass matches at the first pass's solution.
-constexpr double kCalibrationGatesM[] = {1.0, 0.3};
+constexpr std::array<double, 2> kCalibrationGatesM = {1.0, 0.3};
 /// Frames between the two ends of a motion pair (eq 4.13 pairs consecutive
 /// frames). Measured on the simulated rhd handheld drive (80 frames, 10 Hz):
 /// with consecutive frames sigma_min2 of Q_K reached only 0.13 < sigma_R =
@@ -82,11 +83,7 @@ struct SlamEstimator::Track {
     SE3 T_world_base;   ///< trusted odometry, same frame
   };
   std::deque<PosePair> recent;              ///< the last kPairStride + 1 frames, without gaps
-  struct WindowFrame {
-    slam::LidarFrameFeatures features;
-    SE3 T_world_base;                       ///< in the current odometry's world
-  };
-  std::deque<WindowFrame> window;
+  std::vector<slam::CalibrationFrame> window;  ///< the last N + 1 frames while calibrating
   struct Pending {
     Scan scan;
     double stamp = 0.0;
@@ -181,38 +178,20 @@ void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std
   slam::StageSeconds unused{};
   slam::run_front_end(previous->scan, previous->stamp, track.setup, velocity, config_.odometry.front_end, track.workspace, track.features, unused);
   track.window.push_back({to_lidar_frame(track.features, track.setup.T_base_lidar), previous->T_world_base});
-  while (track.window.size() > static_cast<std::size_t>(config_.window.size + 1)) track.window.pop_front();
+  if (track.window.size() > static_cast<std::size_t>(config_.window.size + 1)) track.window.erase(track.window.begin());
 
-  // Eq 4.21: the window's poses are fixed by the map; T_base_lidar_j (extrinsic 1 here) is the variable.
-  std::vector<SE3> poses;
-  for (const auto& frame : track.window) poses.push_back(frame.T_world_base);
-  slam::WindowState state = slam::WindowState::make(poses, {SE3::identity(), track.setup.T_base_lidar}, static_cast<int>(poses.size()), true);
+  // Eq 4.21: the window's poses are fixed by the map; T_base_lidar_j is the variable.
   const slam::MapView map{odometry_->edge_map(), odometry_->plane_map(), config_.odometry.registration};
-  slam::WindowSolverConfig solver;
-  solver.huber_delta_m = config_.odometry.registration.huber_delta_m;
-  slam::WindowSolution solution;
-  slam::MapFit fit;
-  for (const double gate : kCalibrationGatesM) {
-    slam::WindowProblem problem;
-    fit = {};
-    for (std::size_t i = 0; i < track.window.size(); ++i) {
-      const SE3 T_world_lidar = track.window[i].T_world_base * state.T_base_lidar[1];
-      const slam::MapFit one = slam::add_map_correspondences(track.window[i].features, static_cast<int>(i), 1, T_world_lidar, map, gate, problem);
-      fit.planes += one.planes;
-      fit.edges += one.edges;
-      fit.residual_sum_m += one.residual_sum_m;
-    }
-    if (problem.planes.size() + problem.edges.size() < 6) return;
-    solution = slam::solve_window(problem, state, solver);
-    state = solution.state;
-  }
-  out.mean_residual_m = fit.mean_residual_m();
-  const calib::WindowVerdict verdict = monitor_.add_window(j, state.T_base_lidar[1], solution.extrinsic_information[1]);
+  const slam::CalibrationWindowResult window =
+      slam::solve_calibration_window(track.window, track.setup.T_base_lidar, map, kCalibrationGatesM, config_.odometry.registration.huber_delta_m);
+  if (!window.solved) return;
+  out.mean_residual_m = window.fit.mean_residual_m();
+  const calib::WindowVerdict verdict = monitor_.add_window(j, window.T_base_lidar, window.information);
   out.lambda_min = verdict.lambda_min;
-  out.window_estimate = state.T_base_lidar[1];
+  out.window_estimate = window.T_base_lidar;
   out.accepted = verdict.accepted;
   track.report.weak = monitor_.lidar(j).weak;
-  if (verdict.accepted) track.setup.T_base_lidar = state.T_base_lidar[1];
+  if (verdict.accepted) track.setup.T_base_lidar = window.T_base_lidar;
   track.report.accepted = monitor_.lidar(j).accepted.size();
   if (!verdict.converged_now) return;
   // Algorithm 1 lines 8-11: the mean of L_calib accepted estimates, covariance alpha Xi_calib.
