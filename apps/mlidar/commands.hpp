@@ -21,6 +21,7 @@ Command register_calibrate(CLI::App& app);
 /// `calibrate refine` under the `calibrate` parent (command_calibrate_refine.cpp).
 Command add_calibrate_refine(CLI::App& calibrate);
 Command register_odometry(CLI::App& app);
+Command register_slam(CLI::App& app);
 
 /// All sub-commands, in the order `mlidar --help` lists them.
 std::vector<Command> register_commands(CLI::App& app);

@@ -109,6 +109,27 @@ std::vector<std::filesystem::path> natural_sorted_clouds(const std::filesystem::
   return clouds;
 }
 
+std::vector<std::optional<std::filesystem::path>> frame_clouds(const std::filesystem::path& folder, std::size_t frames) {
+  const std::vector<std::filesystem::path> clouds = natural_sorted_clouds(folder);
+  std::vector<std::optional<std::filesystem::path>> by_frame(frames);
+  if (clouds.size() >= frames) {
+    std::copy_n(clouds.begin(), frames, by_frame.begin());
+    return by_frame;
+  }
+  for (const auto& cloud : clouds) {
+    const std::string stem = cloud.stem().string();
+    const bool digits = !stem.empty() && stem.size() <= 9 && std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+    const std::size_t k = digits ? static_cast<std::size_t>(std::stoul(stem)) : frames;
+    if (k >= frames)
+      throw InputError(cloud.string(), "file name", "has " + std::to_string(clouds.size()) + " clouds for " + std::to_string(frames) +
+                                                        " stamps: with scans missing, each file must be named by its frame number (0 to " +
+                                                        std::to_string(frames - 1) + "), e.g. 000123.pcd");
+    if (by_frame[k]) throw InputError(cloud.string(), "file name", "names frame " + std::to_string(k) + " like " + by_frame[k]->string());
+    by_frame[k] = cloud;
+  }
+  return by_frame;
+}
+
 OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<void(int, int)>& progress) {
   if (job.dataset.empty() == job.scans.empty()) throw UsageError("give exactly one of --dataset DIR or --scans FOLDER");
   if (!(job.period > 0.0)) throw UsageError("--period must be > 0 seconds");

@@ -11,6 +11,7 @@
 //                     frame, degenerate, retried and lost frame counts
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,14 @@ struct OdometryJobSummary {
 /// Files sorted in natural order: digit runs compare as numbers ("full20" < "full100").
 std::vector<std::filesystem::path> natural_sorted_clouds(const std::filesystem::path& folder);
 bool natural_less(const std::string& a, const std::string& b);
+
+/// One cloud (or none) per frame of a LiDAR's scan folder. With at least
+/// `frames` clouds, the k-th in natural order is frame k (as `mlidar
+/// odometry` reads them). With fewer, some scans are missing: then each file
+/// stem must be its frame number (000123.pcd is frame 123, as the simulator
+/// writes them), and a frame without a file has none. InputError otherwise
+/// (a stem that is not a number below `frames`, or two files for one frame).
+std::vector<std::optional<std::filesystem::path>> frame_clouds(const std::filesystem::path& folder, std::size_t frames);
 
 /// Reads a cloud; keeps the per-point times relative to the frame stamp when
 /// the file's t field holds them (the simulator's convention).

@@ -5,9 +5,7 @@
 #include "mlidar/io/cloud_file.hpp"
 
 namespace mlidar::pipelines {
-namespace {
-
-nlohmann::json summary_of(std::vector<double> values) {
+nlohmann::json timing_summary(std::vector<double> values) {
   if (values.empty()) return {{"mean", 0.0}, {"p50", 0.0}, {"p95", 0.0}, {"max", 0.0}};
   std::sort(values.begin(), values.end());
   double sum = 0.0;
@@ -15,8 +13,6 @@ nlohmann::json summary_of(std::vector<double> values) {
   const auto at = [&](double q) { return values[static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5)]; };
   return {{"mean", sum / static_cast<double>(values.size())}, {"p50", at(0.5)}, {"p95", at(0.95)}, {"max", values.back()}};
 }
-
-}  // namespace
 
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars) {
   nlohmann::json json;
@@ -27,7 +23,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   for (std::size_t s = 0; s < slam::kStageCount; ++s) {
     std::vector<double> stage;
     for (const auto& f : frames) stage.push_back(f.seconds[s]);
-    json["stages"][slam::stage_name(static_cast<slam::Stage>(s))] = summary_of(stage);
+    json["stages"][slam::stage_name(static_cast<slam::Stage>(s))] = timing_summary(stage);
   }
   nlohmann::json per_frame = nlohmann::json::array();
   for (const auto& f : frames) {
@@ -45,9 +41,9 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
                          {"lost", f.lost}, {"retried", f.retried}, {"iterations", r.iterations}, {"match_ratio", r.match_ratio()},
                          {"threshold_m", f.threshold_m}, {"edges", f.edge_features}, {"planes", f.plane_features}});
   }
-  json["total_seconds"] = summary_of(total);
-  json["points_in"] = summary_of(points_in);
-  json["features_out"] = summary_of(features_out);
+  json["total_seconds"] = timing_summary(total);
+  json["points_in"] = timing_summary(points_in);
+  json["features_out"] = timing_summary(features_out);
   json["degenerate_frames"] = degenerate;
   json["retried_frames"] = retried;
   json["lost_frames"] = lost;
@@ -56,10 +52,15 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
 }
 
 void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry) {
-  Scan map;
-  map.points = odometry.plane_map().points();
+  std::vector<Eigen::Vector3f> points = odometry.plane_map().points();
   const auto edges = odometry.edge_map().points();
-  map.points.insert(map.points.end(), edges.begin(), edges.end());
+  points.insert(points.end(), edges.begin(), edges.end());
+  write_map_ply(path, std::move(points));
+}
+
+void write_map_ply(const std::filesystem::path& path, std::vector<Eigen::Vector3f> points) {
+  Scan map;
+  map.points = std::move(points);
   io::CloudFile cloud;
   cloud.format = io::CloudFormat::kPly;
   cloud.table = io::from_scan(map);

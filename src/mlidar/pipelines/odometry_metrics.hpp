@@ -14,7 +14,12 @@ namespace mlidar::pipelines {
 ///  "lost_frames", "per_frame": [{stamp, eigenvalues, translation_observability, degenerate, lost, ...}]}
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars);
 
+/// {mean, p50, p95, max} of `values` (zeros when empty).
+nlohmann::json timing_summary(std::vector<double> values);
+
 /// The odometry's local maps (planes then edges) as a binary PLY, atomically.
 void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry);
+/// Points as a binary PLY, atomically.
+void write_map_ply(const std::filesystem::path& path, std::vector<Eigen::Vector3f> points);
 
 }  // namespace mlidar::pipelines

@@ -65,6 +65,13 @@ Odometry::Odometry(OdometryConfig config, std::vector<LidarSetup> lidars)
   if (lidars_.empty()) throw std::invalid_argument("Odometry: no LiDARs");
 }
 
+void Odometry::set_lidars(std::vector<LidarSetup> lidars) {
+  if (lidars.empty()) throw std::invalid_argument("Odometry::set_lidars: no LiDARs");
+  lidars_ = std::move(lidars);
+  workspaces_ = std::vector<FrontEndWorkspace>(lidars_.size());
+  features_ = std::vector<LidarFeatures>(lidars_.size());
+}
+
 BodyVelocity Odometry::latest_velocity() const {
   if (centroid_poses_.size() < 2) return {};
   const auto& a = centroid_poses_[centroid_poses_.size() - 2];

@@ -74,12 +74,20 @@ class Odometry {
   /// Throws std::invalid_argument for no LiDARs.
   Odometry(OdometryConfig config, std::vector<LidarSetup> lidars);
 
-  /// frame.scans in the order of the LiDARs given at construction; stamps increasing.
+  /// frame.scans in the order of the LiDARs given at construction (or to set_lidars); stamps increasing.
   FrameResult process(const Frame& frame);
+
+  /// From the next frame on, registers and maps these LiDARs (e.g. one more,
+  /// or new extrinsics); the world, the pose history and the local maps are
+  /// kept. Throws std::invalid_argument for no LiDARs.
+  void set_lidars(std::vector<LidarSetup> lidars);
 
   const VoxelMap& plane_map() const { return plane_map_; }
   const VoxelMap& edge_map() const { return edge_map_; }
   const std::vector<LidarSetup>& lidars() const { return lidars_; }
+  /// The last frame's features per LiDAR (construction order), in the base
+  /// frame at that frame's time centroid, i.e. at FrameResult::registration.T_world_base.
+  const std::vector<LidarFeatures>& lidar_features() const { return features_; }
 
  private:
   /// Constant velocity between the last two centroid poses (zero before two).

@@ -4,6 +4,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include "mlidar/slam/map_matcher.hpp"
 #include "mlidar/slam/residuals.hpp"
 
 namespace mlidar::slam {
@@ -30,25 +31,6 @@ struct NormalEquations {
   }
 };
 
-struct Neighbourhood {
-  Vec3 mean;
-  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
-};
-
-bool fit(const std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors>& points, int count, Neighbourhood& out) {
-  Vec3 mean = Vec3::Zero();
-  for (int i = 0; i < count; ++i) mean += points[static_cast<std::size_t>(i)].cast<double>();
-  mean /= count;
-  Mat3 covariance = Mat3::Zero();
-  for (int i = 0; i < count; ++i) {
-    const Vec3 d = points[static_cast<std::size_t>(i)].cast<double>() - mean;
-    covariance.noalias() += d * d.transpose();
-  }
-  out.mean = mean;
-  out.eigen.computeDirect(covariance / count);
-  return out.eigen.info() == Eigen::Success;
-}
-
 struct Matcher {
   const VoxelMap& edge_map;
   const VoxelMap& plane_map;
@@ -59,38 +41,22 @@ struct Matcher {
   double huber_delta;
 
   void plane(const Eigen::Vector3f& p, NormalEquations& eq) const {
-    std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
     const Vec3 q = T * Vec3(p.cast<double>());
-    const int count = plane_map.nearest(q.cast<float>(), config.neighbors, neighborhood_sq, near);
-    Neighbourhood hood;
-    if (count < 3 || !fit(near, count, hood)) return;
-    // Colinear neighbours (one scan line) leave the normal's direction free about the line.
-    if (hood.eigen.eigenvalues()(1) < config.plane_spread * hood.eigen.eigenvalues()(0)) return;
-    const PlaneCoefficients plane{hood.eigen.eigenvectors().col(0), -hood.eigen.eigenvectors().col(0).dot(hood.mean)};
-    for (int i = 0; i < count; ++i)
-      if (std::abs(plane.normal.dot(near[static_cast<std::size_t>(i)].cast<double>()) + plane.offset) > config.plane_tolerance_m) return;
+    const std::optional<PlaneCoefficients> plane = match_plane(plane_map, q, neighborhood_sq, config);
+    if (!plane) return;
     Vec3 r;
     Mat36 J;
-    plane_residual(plane, q, r, J);
+    plane_residual(*plane, q, r, J);
     if (r.norm() > max_residual_m) return;
     eq.add(r, J, huber_weight(r.norm(), huber_delta));
     ++eq.planes;
   }
 
   void edge(const Eigen::Vector3f& p, NormalEquations& eq) const {
-    std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
     const Vec3 q = T * Vec3(p.cast<double>());
-    const int count = edge_map.nearest(q.cast<float>(), config.neighbors, neighborhood_sq, near);
-    Neighbourhood hood;
-    if (count < 3 || !fit(near, count, hood)) return;
-    const Vec3 values = hood.eigen.eigenvalues();
-    if (values(2) < config.edge_linearity * values(1)) return;
-    const Vec3 direction = hood.eigen.eigenvectors().col(2);
-    for (int i = 0; i < count; ++i) {
-      const Vec3 d = near[static_cast<std::size_t>(i)].cast<double>() - hood.mean;
-      if ((d - direction.dot(d) * direction).norm() > config.edge_tolerance_m) return;
-    }
-    const EdgePlanes planes = edge_planes(hood.mean, direction, q);
+    const std::optional<MapLine> line = match_line(edge_map, q, neighborhood_sq, config);
+    if (!line) return;
+    const EdgePlanes planes = edge_planes(line->point, line->direction, q);
     Eigen::Matrix<double, 6, 1> r;
     Eigen::Matrix<double, 6, 6> J;
     Vec3 r1;

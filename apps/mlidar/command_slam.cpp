@@ -1,0 +1,53 @@
+// `mlidar slam`: the M-LOAM back end: odometry with online extrinsic calibration of every LiDAR.
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "apps/mlidar/commands.hpp"
+#include "apps/mlidar/progress_bar.hpp"
+#include "mlidar/pipelines/slam_job.hpp"
+
+namespace mlidar::cli {
+namespace {
+
+/// One line per auxiliary LiDAR: where its calibration stands, and the directions the motion left unobservable.
+void print_lidar(const pipelines::SlamLidarReport& lidar) {
+  std::cout << "  " << lidar.name << ": " << pipelines::to_string(lidar.role);
+  if (lidar.initialized_frame) std::cout << ", initialized at frame " << *lidar.initialized_frame;
+  if (lidar.initialization.planar_motion) std::cout << " (planar motion: translation along the rotation axis fixed to 0)";
+  const auto& sv = lidar.initialization.singular_values;
+  if (lidar.role == pipelines::LidarRole::initializing && lidar.initialization.pairs_stored >= 10 && sv[2] < 0.1 * sv[1])
+    std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
+  if (lidar.converged_frame) std::cout << ", converged at frame " << *lidar.converged_frame;
+  if (lidar.restarts > 0) std::cout << ", " << lidar.restarts << " re-calibration(s) after an extrinsic shock";
+  if (lidar.missing_frames > 0) std::cout << ", " << lidar.missing_frames << " frame(s) without a scan";
+  std::cout << '\n';
+  for (const auto& weak : lidar.weak) std::cout << "    weakly observed: " << weak.description << " (information " << weak.eigenvalue << ")\n";
+}
+
+int run_slam(const pipelines::SlamJob& job) {
+  const auto summary = pipelines::run_slam_job(job, terminal_progress_bar());
+  std::cout << "wrote " << job.out.string() << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3 << " ms per frame, "
+            << summary.lost_frames << " lost\n";
+  for (const auto& lidar : summary.lidars) print_lidar(lidar);
+  if (!summary.all_converged())
+    std::cerr << "warning: some LiDAR's calibration did not converge; its extrinsic in extrinsics.yaml has no covariance (see metrics.json)\n";
+  if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
+  return summary.all_converged() && summary.lost_frames == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+Command register_slam(CLI::App& app) {
+  auto job = std::make_shared<pipelines::SlamJob>();
+  CLI::App* sub = app.add_subcommand("slam", "Multi-LiDAR odometry with online extrinsic calibration (M-LOAM back end)");
+  sub->add_option("--dataset", job->dataset, "Dataset folder (dataset.yaml, times.txt, scans/)")->required();
+  sub->add_option("--config", job->config, "Back-end parameters (config/mloam.yaml documents every key; default Table 4.2)");
+  sub->add_option("--calibrate", job->calibrate, "online: initialize and calibrate every LiDAR online; refine: calibrate from the dataset's extrinsics; fixed: use them as given")
+      ->capture_default_str();
+  sub->add_option("--threads", job->threads, "Worker threads (0: all cores)")->capture_default_str();
+  sub->add_option("--out", job->out, "Run folder: trajectory.tum/.kitti, extrinsics.yaml, map.ply, metrics.json")->required();
+  return {sub, [job] { return run_slam(*job); }};
+}
+
+}  // namespace mlidar::cli

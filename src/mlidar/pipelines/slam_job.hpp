@@ -1,0 +1,48 @@
+#pragma once
+// `mlidar slam`: the M-LOAM estimator (slam_estimator.hpp) over a dataset
+// folder (io/dataset.hpp). The LiDARs run base first (the dataset's base, or
+// its first LiDAR when the base names none), then by name, so the order the
+// dataset lists them in does not matter. Online (default), the estimate does
+// not start from the dataset's extrinsics (their rotations only tell each
+// LiDAR's own odometry which way is up): every auxiliary LiDAR is
+// initialized and calibrated online; refine calibrates starting from them (no hand-eye:
+// the way under planar motion); fixed uses them as given. A LiDAR's scan folder may
+// lack some frames (see frame_clouds: files named by frame number); such a
+// LiDAR is reported and the others carry on. Writes the run folder, created
+// at the end, every file atomically:
+//   trajectory.tum / trajectory.kitti   T_world_base at each stamp
+//   extrinsics.yaml   every LiDAR (dataset order), with alpha Xi_calib as covariance once converged
+//   map.ply           the last local map, world frame
+//   metrics.json      see slam_metrics.hpp
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mlidar/core/types.hpp"
+#include "mlidar/pipelines/slam_estimator.hpp"
+
+namespace mlidar::pipelines {
+
+struct SlamJob {
+  std::filesystem::path dataset;
+  std::filesystem::path config;       ///< mloam.yaml, or empty for the defaults (Table 4.2)
+  std::string calibrate = "online";   ///< "online", "refine" or "fixed"
+  int threads = 0;                    ///< 0 = TBB's default
+  std::filesystem::path out;
+};
+
+struct SlamJobSummary {
+  std::size_t frames = 0;
+  std::size_t lost_frames = 0;
+  double mean_frame_seconds = 0.0;
+  Trajectory trajectory;
+  std::vector<SlamLidarReport> lidars;  ///< dataset order
+  bool all_converged() const;           ///< every LiDAR trusted at the end
+};
+
+/// UsageError for bad options; InputError for bad files (dataset, config).
+/// `progress(done, total)` after each frame.
+SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, int)>& progress = {});
+
+}  // namespace mlidar::pipelines

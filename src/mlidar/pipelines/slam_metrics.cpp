@@ -1,0 +1,102 @@
+#include "mlidar/pipelines/slam_metrics.hpp"
+
+#include "mlidar/pipelines/odometry_metrics.hpp"
+
+namespace mlidar::pipelines {
+namespace {
+
+nlohmann::json number_or_null(double value) { return value < 0.0 ? nlohmann::json(nullptr) : nlohmann::json(value); }
+
+template <typename T>
+nlohmann::json optional_json(const std::optional<T>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json stage_timings(const std::vector<SlamFrame>& frames, const std::vector<double>& load_seconds, nlohmann::json& total) {
+  std::vector<double> odometry, initialization, calibration, shock, sum;
+  for (const auto& f : frames) {
+    odometry.push_back(f.seconds.odometry);
+    initialization.push_back(f.seconds.initialization);
+    calibration.push_back(f.seconds.calibration);
+    shock.push_back(f.seconds.shock);
+    sum.push_back(f.seconds.odometry + f.seconds.initialization + f.seconds.calibration + f.seconds.shock);
+  }
+  total = timing_summary(sum);
+  return {{"load", timing_summary(load_seconds)}, {"odometry", timing_summary(odometry)}, {"initialization", timing_summary(initialization)},
+          {"calibration", timing_summary(calibration)}, {"shock", timing_summary(shock)}};
+}
+
+nlohmann::json pose_json(const SE3& T) {
+  const Quat q = T.rotation();
+  const Vec3 t = T.translation();
+  return {{"translation", {t.x(), t.y(), t.z()}}, {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+nlohmann::json lidar_frame_json(const SlamLidarFrame& l) {
+  return {{"window_estimate", l.window_estimate ? pose_json(*l.window_estimate) : nlohmann::json(nullptr)}, {"role", std::string(to_string(l.role))}, {"scan_missing", l.scan_missing}, {"lambda_min", number_or_null(l.lambda_min)},
+          {"accepted", l.accepted}, {"mean_residual_m", number_or_null(l.mean_residual_m)}, {"shock", l.shock}};
+}
+
+nlohmann::json lidar_report_json(const SlamLidarReport& l) {
+  const auto& init = l.initialization;
+  nlohmann::json weak = nlohmann::json::array();
+  for (const auto& w : l.weak) weak.push_back({{"description", w.description}, {"eigenvalue", w.eigenvalue}});
+  const Quat q = l.T_base_lidar.rotation();
+  const Vec3 t = l.T_base_lidar.translation();
+  nlohmann::json covariance = nullptr;
+  if (l.covariance) covariance = std::vector<double>(l.covariance->data(), l.covariance->data() + 36);  // symmetric: order irrelevant
+  return {{"role", std::string(to_string(l.role))},
+          {"translation", {t.x(), t.y(), t.z()}},
+          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+          {"covariance", covariance},
+          {"initialization",
+           {{"state", std::string(calib::to_string(init.state))},
+            {"frame", optional_json(l.initialized_frame)},
+            {"pairs_stored", init.pairs_stored},
+            {"pairs_seen", init.pairs_seen},
+            {"singular_values", init.singular_values},
+            {"translation_eigenvalues", init.translation_eigenvalues},
+            {"rotation_rms_rad", init.rotation_rms_rad},
+            {"planar_motion", init.planar_motion},
+            {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}}}},
+          {"converged_frame", optional_json(l.converged_frame)},
+          {"accepted", l.accepted},
+          {"restarts", l.restarts},
+          {"shock_frames", l.shock_frames},
+          {"missing_frames", l.missing_frames},
+          {"weak_directions", weak}};
+}
+
+}  // namespace
+
+nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std::vector<std::size_t>& order,
+                                 const std::vector<SlamLidarReport>& lidars, const std::vector<double>& load_seconds,
+                                 const std::string& calibrate) {
+  nlohmann::json json;
+  json["frames"] = frames.size();
+  json["calibrate"] = calibrate;
+  json["lidars"] = nlohmann::json::array();
+  for (const auto& l : lidars) json["lidars"].push_back(l.name);
+  nlohmann::json total;
+  json["stages"] = stage_timings(frames, load_seconds, total);
+  json["total_seconds"] = total;
+  std::size_t lost = 0, changes = 0, calibrating = 0;
+  nlohmann::json per_frame = nlohmann::json::array();
+  for (const auto& f : frames) {
+    lost += f.lost ? 1 : 0;
+    changes += f.trusted_changed ? 1 : 0;
+    calibrating += f.calibrating ? 1 : 0;
+    nlohmann::json per_lidar = nlohmann::json::object();
+    for (std::size_t e = 0; e < f.lidars.size(); ++e) per_lidar[lidars.at(order.at(e)).name] = lidar_frame_json(f.lidars[e]);
+    per_frame.push_back({{"stamp", f.stamp}, {"mode", f.calibrating ? "calibration" : "odometry"}, {"lost", f.lost},
+                         {"trusted_changed", f.trusted_changed}, {"lidars", per_lidar}});
+  }
+  json["lost_frames"] = lost;
+  json["trusted_set_changes"] = changes;
+  json["calibration_frames"] = calibrating;
+  json["per_frame"] = std::move(per_frame);
+  for (const auto& l : lidars) json["per_lidar"][l.name] = lidar_report_json(l);
+  return json;
+}
+
+}  // namespace mlidar::pipelines

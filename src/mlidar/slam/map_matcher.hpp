@@ -1,0 +1,30 @@
+#pragma once
+// Correspondence search against a voxel-hashed local map (thesis eq 4.7/4.8):
+// the k nearest map points of a world point, fitted by PCA
+//   plane: every neighbour within plane_tolerance_m of the plane and the
+//          neighbours not colinear (middle eigenvalue >= plane_spread x smallest);
+//   line:  largest eigenvalue >= edge_linearity x middle one and every
+//          neighbour within edge_tolerance_m of the line.
+// Shared by scan-to-map registration and the back end's window correspondences.
+#include <optional>
+
+#include "mlidar/core/se3.hpp"
+#include "mlidar/slam/residuals.hpp"
+#include "mlidar/slam/scan_to_map.hpp"
+#include "mlidar/slam/voxel_map.hpp"
+
+namespace mlidar::slam {
+
+/// A map line through `point` along the unit `direction` (world frame).
+struct MapLine {
+  Vec3 point = Vec3::Zero();
+  Vec3 direction = Vec3::UnitX();
+};
+
+/// The plane of q_world's map neighbours within sqrt(search_radius_sq), or none.
+std::optional<PlaneCoefficients> match_plane(const VoxelMap& plane_map, const Vec3& q_world, float search_radius_sq,
+                                             const RegistrationConfig& config);
+/// The line of q_world's map neighbours within sqrt(search_radius_sq), or none.
+std::optional<MapLine> match_line(const VoxelMap& edge_map, const Vec3& q_world, float search_radius_sq, const RegistrationConfig& config);
+
+}  // namespace mlidar::slam

@@ -1,0 +1,226 @@
+// End-to-end `mlidar slam` on a simulated rhd handheld drive (campus, 80
+// frames, the dataset's initial extrinsic perturbed by 5 deg / 0.1 m):
+// online calibration converges (Algorithm 1) to the true extrinsic, the
+// trajectory tracks the ground truth, and listing the LiDARs in another order
+// changes nothing; fixed mode with the true extrinsics is the odometry; a
+// LiDAR with missing scans is reported and the run carries on; a bad config
+// key exits 3 and writes nothing; an injected extrinsic shock (Table 4.6) is
+// detected within a few frames.
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "apps/cli_runner.hpp"
+#include "mlidar/eval/trajectory_metrics.hpp"
+#include "mlidar/io/cloud_file.hpp"
+#include "mlidar/io/dataset.hpp"
+#include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/trajectory_io.hpp"
+#include "test_support.hpp"
+
+namespace mlidar::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kFrames = 80;
+// Measured (seed 1): right LiDAR 0.08 deg / 0.026 m off, ATE 0.011 m (the
+// left LiDAR's odometry alone: 0.011 m); the hand-eye starts 0.8 deg off.
+// The tolerances leave about 2x margin: the translation error comes from
+// window-to-window scatter of +-3 cm (odometry pose errors in the fixed
+// window poses), which L_calib = 25 averages only partly.
+constexpr double kMaxRotationDeg = 0.3;
+constexpr double kMaxTranslationM = 0.05;
+constexpr double kMaxAteM = 0.03;
+
+double rotation_deg(const SE3& a, const SE3& b) { return (a.inverse() * b).log().tail<3>().norm() * 57.29577951308232; }
+double translation_m(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
+
+double ate_rmse(const Trajectory& gt, const Trajectory& est) {
+  return eval::evaluate_trajectory(gt, est, {}, "groundtruth", "estimate").ate.translation_m.rmse;
+}
+
+fs::path simulate(const fs::path& dir, int frames, const std::string& perturb) {
+  const fs::path sim = dir / "sim";
+  const auto result = run_cli("simulate drive --rig rhd --scene campus --trajectory handheld --frames " + std::to_string(frames) +
+                              " --seed 1 --perturb " + perturb + " --out " + quoted(sim.string()));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  return sim;
+}
+
+/// A copy of the dataset (scans shared through a link) with its LiDARs reversed and/or the true extrinsics as initial ones.
+fs::path dataset_variant(const fs::path& sim, const fs::path& out, bool reverse, bool true_extrinsics) {
+  fs::create_directories(out);
+  io::Dataset dataset = io::read_dataset_yaml(sim / "dataset.yaml");
+  if (reverse) std::reverse(dataset.lidars.begin(), dataset.lidars.end());
+  if (true_extrinsics) {
+    const io::Extrinsics truth = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
+    for (auto& lidar : dataset.lidars) lidar.initial_extrinsic = truth.find(lidar.name)->T_base_lidar;
+  }
+  dataset.groundtruth = {};
+  io::write_dataset_yaml(out / "dataset.yaml", dataset);
+  fs::copy_file(sim / dataset.times, out / dataset.times);
+  fs::create_directory_symlink(fs::absolute(sim / "scans"), out / "scans");
+  return out;
+}
+
+nlohmann::json read_metrics(const fs::path& run) { return nlohmann::json::parse(std::ifstream(run / "metrics.json")); }
+
+void expect_documented_keys(const nlohmann::json& metrics, int frames) {
+  EXPECT_EQ(metrics["frames"].get<int>(), frames);
+  for (const char* stage : {"load", "odometry", "initialization", "calibration", "shock"})
+    for (const char* stat : {"mean", "p50", "p95", "max"}) EXPECT_TRUE(metrics["stages"][stage].contains(stat)) << stage << " " << stat;
+  ASSERT_EQ(metrics["per_frame"].size(), static_cast<std::size_t>(frames));
+  const auto& frame = metrics["per_frame"].back();
+  for (const char* key : {"stamp", "mode", "lost", "trusted_changed", "lidars"}) EXPECT_TRUE(frame.contains(key)) << key;
+  for (const char* key : {"role", "scan_missing", "lambda_min", "accepted", "window_estimate", "mean_residual_m", "shock"})
+    EXPECT_TRUE(frame["lidars"]["right"].contains(key)) << key;
+  for (const char* key : {"role", "translation", "quaternion_wxyz", "covariance", "initialization", "converged_frame", "accepted",
+                          "restarts", "shock_frames", "missing_frames", "weak_directions"})
+    EXPECT_TRUE(metrics["per_lidar"]["right"].contains(key)) << key;
+}
+
+TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate(dir, kFrames, "5,0.1");
+  const fs::path run = dir / "run";
+  const CliResult result = run_cli("slam --dataset " + quoted(sim.string()) + " --out " + quoted(run.string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+
+  const io::Extrinsics truth = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
+  const io::Extrinsics estimate = io::read_extrinsics(run / "extrinsics.yaml");
+  ASSERT_NE(estimate.find("right"), nullptr);
+  const SE3& T_est = estimate.find("right")->T_base_lidar;
+  EXPECT_LT(rotation_deg(truth.find("right")->T_base_lidar, T_est), kMaxRotationDeg);
+  EXPECT_LT(translation_m(truth.find("right")->T_base_lidar, T_est), kMaxTranslationM);
+  ASSERT_TRUE(estimate.find("right")->covariance.has_value());
+  EXPECT_GT(estimate.find("right")->covariance->diagonal().minCoeff(), 0.0);
+
+  const Trajectory est = io::read_tum(run / "trajectory.tum");
+  EXPECT_EQ(io::read_kitti_poses(run / "trajectory.kitti").poses.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_LT(ate_rmse(io::read_tum(sim / "groundtruth" / "trajectory.tum"), est), kMaxAteM);
+  EXPECT_GT(io::read_cloud(run / "map.ply").table.num_points, 1000U);
+
+  const auto metrics = read_metrics(run);
+  expect_documented_keys(metrics, kFrames);
+  EXPECT_EQ(metrics["per_frame"].front()["mode"], "calibration");
+  EXPECT_EQ(metrics["per_frame"].back()["mode"], "odometry");
+  const auto& right = metrics["per_lidar"]["right"];
+  EXPECT_EQ(right["role"], "trusted");
+  EXPECT_EQ(right["initialization"]["state"], "ready");
+  EXPECT_FALSE(right["initialization"]["planar_motion"].get<bool>());
+  EXPECT_EQ(right["accepted"].get<int>(), 25);  // L_calib (Table 4.2)
+  EXPECT_LT(right["converged_frame"].get<int>(), kFrames);
+
+  // The same data with the LiDARs listed in reverse order.
+  const fs::path reversed = dataset_variant(sim, dir / "reversed", true, false);
+  const fs::path run2 = dir / "run2";
+  ASSERT_EQ(run_cli("slam --dataset " + quoted(reversed.string()) + " --out " + quoted(run2.string())).exit_code, 0);
+  const Trajectory est2 = io::read_tum(run2 / "trajectory.tum");
+  ASSERT_EQ(est2.poses.size(), est.poses.size());
+  for (std::size_t k = 0; k < est.poses.size(); ++k)
+    EXPECT_LT(translation_m(est.poses[k].T_world_base, est2.poses[k].T_world_base), 1e-3) << "frame " << k;
+  const SE3& T_est2 = io::read_extrinsics(run2 / "extrinsics.yaml").find("right")->T_base_lidar;
+  EXPECT_LT(rotation_deg(T_est, T_est2), 0.01);
+  EXPECT_LT(translation_m(T_est, T_est2), 1e-3);
+}
+
+TEST(CliSlam, FixedModeIsTheOdometryAndMissingScansAreReported) {
+  constexpr int kShortFrames = 30;
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate(dir, kShortFrames, "0,0");
+  const fs::path truth = dataset_variant(sim, dir / "truth", false, true);
+  const fs::path run = dir / "run";
+  ASSERT_EQ(run_cli("slam --dataset " + quoted(truth.string()) + " --calibrate fixed --out " + quoted(run.string())).exit_code, 0);
+  const fs::path odometry = dir / "odometry";
+  ASSERT_EQ(run_cli("odometry --dataset " + quoted(truth.string()) + " --out " + quoted(odometry.string())).exit_code, 0);
+  const Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");
+  const double slam_ate = ate_rmse(gt, io::read_tum(run / "trajectory.tum"));
+  EXPECT_NEAR(slam_ate, ate_rmse(gt, io::read_tum(odometry / "trajectory.tum")), 1e-3);
+  EXPECT_LT(slam_ate, kMaxAteM);
+  EXPECT_EQ(read_metrics(run)["per_frame"].front()["mode"], "odometry");
+
+  // Frames 10-14 of the right LiDAR removed (the scans folder is the simulator's own, not the link).
+  for (int k = 10; k < 15; ++k) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "%06d.pcd", k);
+    ASSERT_TRUE(fs::remove(sim / "scans" / "right" / name)) << name;
+  }
+  const fs::path gap_run = dir / "gap";
+  const CliResult gap = run_cli("slam --dataset " + quoted(truth.string()) + " --calibrate fixed --out " + quoted(gap_run.string()));
+  ASSERT_EQ(gap.exit_code, 0) << gap.output;
+  EXPECT_NE(gap.output.find("5 frame(s) without a scan"), std::string::npos) << gap.output;
+  const auto metrics = read_metrics(gap_run);
+  EXPECT_EQ(metrics["per_lidar"]["right"]["missing_frames"].get<int>(), 5);
+  EXPECT_TRUE(metrics["per_frame"][12]["lidars"]["right"]["scan_missing"].get<bool>());
+  EXPECT_FALSE(metrics["per_frame"][15]["lidars"]["right"]["scan_missing"].get<bool>());
+  EXPECT_LT(ate_rmse(gt, io::read_tum(gap_run / "trajectory.tum")), kMaxAteM);
+}
+
+/// Moves a LiDAR's mounting from frame `first` on: its points p become Delta^-1 p (T_base_lidar -> T_base_lidar Delta).
+void shift_mounting(const fs::path& folder, int first, int frames, const SE3& Delta) {
+  const SE3 T_new_old = Delta.inverse();
+  for (int k = first; k < frames; ++k) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "%06d.pcd", k);
+    io::CloudFile cloud = io::read_cloud(folder / name);
+    std::array<io::FieldColumn*, 3> xyz{cloud.table.find("x"), cloud.table.find("y"), cloud.table.find("z")};
+    for (const auto* column : xyz) ASSERT_TRUE(column != nullptr && column->type == io::ScalarType::kF32);
+    for (std::size_t i = 0; i < cloud.table.num_points; ++i) {
+      std::array<float, 3> p{};
+      for (std::size_t a = 0; a < 3; ++a) std::memcpy(&p[a], xyz[a]->data.data() + i * sizeof(float), sizeof(float));
+      const Vec3 moved = T_new_old * Vec3(p[0], p[1], p[2]);
+      for (std::size_t a = 0; a < 3; ++a) {
+        const auto value = static_cast<float>(moved(static_cast<Eigen::Index>(a)));
+        std::memcpy(xyz[a]->data.data() + i * sizeof(float), &value, sizeof(float));
+      }
+    }
+    fs::remove(folder / name);
+    io::write_cloud(folder / name, cloud);
+  }
+}
+
+TEST(CliSlam, ExtrinsicShockIsDetectedAtItsFrame) {
+  // Thesis Table 4.6's shock: 10 deg about each axis and 0.1 m along each, on the right LiDAR from frame 30.
+  constexpr int kShockFrames = 50;
+  constexpr int kShockFrame = 30;
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate(dir, kShockFrames, "0,0");
+  const fs::path truth = dataset_variant(sim, dir / "truth", false, true);
+  const double deg = 0.017453292519943295;
+  Vec6 delta;
+  delta << 0.1, 0.1, 0.1, 10 * deg, 10 * deg, 10 * deg;
+  shift_mounting(sim / "scans" / "right", kShockFrame, kShockFrames, SE3::exp(delta));
+  const fs::path run = dir / "run";
+  const CliResult result = run_cli("slam --dataset " + quoted(truth.string()) + " --calibrate fixed --out " + quoted(run.string()));
+  ASSERT_LE(result.exit_code, 1) << result.output;
+  const auto metrics = read_metrics(run);
+  EXPECT_TRUE(metrics["per_lidar"]["left"]["shock_frames"].empty()) << metrics["per_lidar"]["left"]["shock_frames"];
+  const auto& shocks = metrics["per_lidar"]["right"]["shock_frames"];
+  ASSERT_FALSE(shocks.empty());
+  // The trigger needs `consecutive` (5) high frames in a row.
+  EXPECT_GE(shocks.front().get<int>(), kShockFrame);
+  EXPECT_LE(shocks.front().get<int>(), kShockFrame + 8);
+}
+
+TEST(CliSlam, BadConfigKeyExitsThreeAndWritesNothing) {
+  const fs::path dir = scratch_dir();
+  std::ofstream(dir / "mloam.yaml") << "window:\n  sise: 4\n";
+  fs::create_directories(dir / "data");
+  const fs::path run = dir / "run";
+  const CliResult result = run_cli("slam --dataset " + quoted((dir / "data").string()) + " --config " + quoted((dir / "mloam.yaml").string()) +
+                                   " --out " + quoted(run.string()));
+  EXPECT_EQ(result.exit_code, 3) << result.output;
+  EXPECT_NE(result.output.find("window.sise"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(run));
+  EXPECT_EQ(run_cli("slam --dataset " + quoted((dir / "data").string()) + " --calibrate sometimes --out " + quoted(run.string())).exit_code, 2);
+}
+
+}  // namespace
+}  // namespace mlidar::test

@@ -1,0 +1,85 @@
+// map_matcher / map_correspondences against analytic geometry: map points on
+// a known plane or line give back that plane or line; a point offset from it
+// by a known distance gives that residual; a window problem built from them
+// has the documented frame, LiDAR and world geometry; a feature beyond the gate is dropped.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "mlidar/slam/map_correspondences.hpp"
+#include "mlidar/slam/map_matcher.hpp"
+
+namespace mlidar::slam {
+namespace {
+
+/// A 0.1 m grid on the plane z = 0.3 over [-2, 2]^2.
+VoxelMap plane_map() {
+  VoxelMap map(1.0, 50);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = -20; i <= 20; ++i)
+    for (int j = -20; j <= 20; ++j) points.emplace_back(0.1F * static_cast<float>(i), 0.1F * static_cast<float>(j), 0.3F);
+  map.add(points);
+  return map;
+}
+
+/// Points every 0.05 m on the line through (1, 1, 0) along y.
+VoxelMap line_map() {
+  VoxelMap map(1.0, 50);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = -40; i <= 40; ++i) points.emplace_back(1.0F, 1.0F + 0.05F * static_cast<float>(i), 0.0F);
+  map.add(points);
+  return map;
+}
+
+TEST(MapMatcher, PlaneOfGridNeighboursIsTheGridPlane) {
+  const VoxelMap map = plane_map();
+  const RegistrationConfig config;
+  const auto plane = match_plane(map, Vec3(0.23, -0.41, 0.35), 1.0F, config);
+  ASSERT_TRUE(plane.has_value());
+  EXPECT_NEAR(std::abs(plane->normal.z()), 1.0, 1e-9);
+  // n^T q + d at a point 0.05 m above the plane.
+  EXPECT_NEAR(std::abs(plane->normal.dot(Vec3(0.23, -0.41, 0.35)) + plane->offset), 0.05, 1e-6);
+  // Beyond the search radius there is nothing to fit.
+  EXPECT_FALSE(match_plane(map, Vec3(0.0, 0.0, 2.0), 1.0F, config).has_value());
+}
+
+TEST(MapMatcher, LineOfColinearNeighboursIsTheLine) {
+  const VoxelMap map = line_map();
+  const RegistrationConfig config;
+  const auto line = match_line(map, Vec3(1.02, 1.3, 0.01), 1.0F, config);
+  ASSERT_TRUE(line.has_value());
+  EXPECT_NEAR(std::abs(line->direction.y()), 1.0, 1e-9);
+  EXPECT_NEAR(line->point.x(), 1.0, 1e-6);
+  EXPECT_NEAR(line->point.z(), 0.0, 1e-6);
+  // Planar neighbours are no line.
+  EXPECT_FALSE(match_line(plane_map(), Vec3(0.0, 0.0, 0.3), 1.0F, config).has_value());
+}
+
+TEST(MapCorrespondences, WindowTermsAndFitFollowThePose) {
+  const VoxelMap planes = plane_map();
+  const VoxelMap edges = line_map();
+  const RegistrationConfig config;
+  const MapView map{edges, planes, config};
+  // LiDAR-frame features; the pose moves them up by 0.3 m and the plane feature ends 0.04 m above the plane.
+  LidarFrameFeatures features;
+  features.planes = {Eigen::Vector3f(0.2F, 0.1F, 0.04F), Eigen::Vector3f(0.2F, 0.1F, 3.0F)};  // the second: far beyond the gate
+  features.edges = {Eigen::Vector3f(1.03F, 1.2F, -0.3F)};
+  const SE3 T_world_lidar(Quat::Identity(), Vec3(0.0, 0.0, 0.3));
+  WindowProblem problem;
+  const MapFit fit = add_map_correspondences(features, 2, 1, T_world_lidar, map, 0.5, problem);
+  ASSERT_EQ(problem.planes.size(), 1U);
+  ASSERT_EQ(problem.edges.size(), 1U);
+  EXPECT_EQ(problem.planes[0].frame, 2);
+  EXPECT_EQ(problem.planes[0].lidar, 1);
+  EXPECT_NEAR((problem.planes[0].point_lidar - Vec3(0.2, 0.1, 0.04)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR(std::abs(problem.edges[0].line_direction_world.y()), 1.0, 1e-9);
+  EXPECT_NEAR(fit.mean_residual_m(), (0.04 + 0.03) / 2.0, 1e-6);
+  const MapFit same = map_fit(features.edges, features.planes, T_world_lidar, map, 0.5);
+  EXPECT_EQ(same.planes, 1U);
+  EXPECT_EQ(same.edges, 1U);
+  EXPECT_NEAR(same.mean_residual_m(), fit.mean_residual_m(), 1e-12);
+  EXPECT_TRUE(std::isnan(map_fit({}, {}, T_world_lidar, map, 0.5).mean_residual_m()));
+}
+
+}  // namespace
+}  // namespace mlidar::slam
