@@ -2,6 +2,7 @@
 // Helpers shared by the tests: where the shared real data lives, scratch folders.
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -22,10 +23,14 @@ inline std::filesystem::path shared_data() {
       GTEST_SKIP() << "shared real data not found (set MLIDAR_SHARED_DATA to ../shared/data)"; \
   } while (0)
 
-/// A fresh empty folder under the system temp dir, unique per test.
+/// A fresh empty folder under the system temp dir, unique per test and per
+/// build tree (keyed by the mlidar binary CMake compiled in), so the Release
+/// and sanitizer suites, or two checkouts, can run at once without deleting
+/// each other's files. The same tree reuses (and first empties) its folders.
 inline std::filesystem::path scratch_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::filesystem::path dir = std::filesystem::temp_directory_path() / "mlidar_tests" /
+  const std::size_t tree = std::hash<std::string>{}(MLIDAR_TEST_BIN);
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / "mlidar_tests" / std::to_string(tree % 1000000007u) /
                               (std::string(info->test_suite_name()) + "." + info->name());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
