@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_runner.hpp"
+#include "apps/dataset_variants.hpp"
 #include "mlidar/io/dataset.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
 #include "test_support.hpp"
@@ -20,20 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double rotation_deg(const SE3& a, const SE3& b) { return (a.inverse() * b).log().tail<3>().norm() * 57.29577951308232; }
-double translation_m(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
 
-/// The same dataset with its LiDARs listed in reverse order (scans shared through a link).
-fs::path reversed_copy(const fs::path& sim, const fs::path& out) {
-  fs::create_directories(out);
-  io::Dataset dataset = io::read_dataset_yaml(sim / "dataset.yaml");
-  std::reverse(dataset.lidars.begin(), dataset.lidars.end());
-  dataset.groundtruth = {};
-  io::write_dataset_yaml(out / "dataset.yaml", dataset);
-  fs::copy_file(sim / dataset.times, out / dataset.times);
-  fs::create_directory_symlink(fs::absolute(sim / "scans"), out / "scans");
-  return out;
-}
 
 TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
   const fs::path dir = scratch_dir();
@@ -59,7 +47,7 @@ TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
   EXPECT_GT(json["lidars"][1]["handeye"]["pairs_used"].get<int>(), 10);
   EXPECT_EQ(json["lidars"][1]["handeye"]["singular_values"].size(), 4u);
 
-  const fs::path reversed = reversed_copy(sim, dir / "reversed");
+  const fs::path reversed = dataset_variant(sim, dir / "reversed", true, false);
   const fs::path run2 = dir / "run2";
   ASSERT_EQ(run_cli("calibrate auto --dataset " + quoted(reversed.string()) + " --base left --out " +
                     quoted(run2.string())).exit_code, 0);

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_runner.hpp"
+#include "apps/dataset_variants.hpp"
 #include "mlidar/core/so3.hpp"
 #include "mlidar/io/dataset.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
@@ -22,8 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double rotation_deg(const SE3& a, const SE3& b) { return (a.inverse() * b).log().tail<3>().norm() * 57.29577951308232; }
-double translation_m(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
 
 SE3 pose_from_json(const nlohmann::json& j) {
   const auto& t = j["translation"];
@@ -39,17 +38,6 @@ SE3 estimate(const fs::path& run, const std::string& lidar) {
   return found == nullptr ? SE3() : found->T_base_lidar;
 }
 
-/// The same dataset with its LiDARs listed in reverse order (scans shared through a link).
-fs::path reversed_copy(const fs::path& sim, const fs::path& out) {
-  fs::create_directories(out);
-  io::Dataset dataset = io::read_dataset_yaml(sim / "dataset.yaml");
-  std::reverse(dataset.lidars.begin(), dataset.lidars.end());
-  dataset.groundtruth = {};
-  io::write_dataset_yaml(out / "dataset.yaml", dataset);
-  fs::copy_file(sim / dataset.times, out / dataset.times);
-  fs::create_directory_symlink(fs::absolute(sim / "scans"), out / "scans");
-  return out;
-}
 
 std::string auto_command(const fs::path& dataset, const fs::path& run, const std::string& extra = "") {
   return "calibrate auto --dataset " + quoted(dataset.string()) + " --out " + quoted(run.string()) + extra;
@@ -100,7 +88,7 @@ TEST(CliAutoCalibRefine, HandheldRhdRefineBeatsHandEyeAndConvergesFromPerturbedI
   EXPECT_EQ(refine_json["lidars"][1]["refine"]["start"], "init");
 
   // The order the dataset lists its LiDARs in does not matter.
-  const fs::path reversed = reversed_copy(sim, dir / "reversed");
+  const fs::path reversed = dataset_variant(sim, dir / "reversed", true, false);
   const fs::path run_reversed = dir / "refine_reversed";
   ASSERT_EQ(run_cli(auto_command(reversed, run_reversed, from_init + " --base left")).exit_code, 0);
   const SE3 T_reordered = estimate(run_reversed, "right");

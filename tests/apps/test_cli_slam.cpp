@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_runner.hpp"
+#include "apps/dataset_variants.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/dataset.hpp"
@@ -39,8 +40,6 @@ constexpr double kMaxRotationDeg = 0.3;
 constexpr double kMaxTranslationM = 0.05;
 constexpr double kMaxAteM = 0.03;
 
-double rotation_deg(const SE3& a, const SE3& b) { return (a.inverse() * b).log().tail<3>().norm() * 57.29577951308232; }
-double translation_m(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
 
 double ate_rmse(const Trajectory& gt, const Trajectory& est) {
   return eval::evaluate_trajectory(gt, est, {}, "groundtruth", "estimate").ate.translation_m.rmse;
@@ -54,21 +53,6 @@ fs::path simulate(const fs::path& dir, int frames, const std::string& perturb) {
   return sim;
 }
 
-/// A copy of the dataset (scans shared through a link) with its LiDARs reversed and/or the true extrinsics as initial ones.
-fs::path dataset_variant(const fs::path& sim, const fs::path& out, bool reverse, bool true_extrinsics) {
-  fs::create_directories(out);
-  io::Dataset dataset = io::read_dataset_yaml(sim / "dataset.yaml");
-  if (reverse) std::reverse(dataset.lidars.begin(), dataset.lidars.end());
-  if (true_extrinsics) {
-    const io::Extrinsics truth = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
-    for (auto& lidar : dataset.lidars) lidar.initial_extrinsic = truth.find(lidar.name)->T_base_lidar;
-  }
-  dataset.groundtruth = {};
-  io::write_dataset_yaml(out / "dataset.yaml", dataset);
-  fs::copy_file(sim / dataset.times, out / dataset.times);
-  fs::create_directory_symlink(fs::absolute(sim / "scans"), out / "scans");
-  return out;
-}
 
 nlohmann::json read_metrics(const fs::path& run) { return nlohmann::json::parse(std::ifstream(run / "metrics.json")); }
 

@@ -1,0 +1,36 @@
+#pragma once
+// Shared by the CLI tests that run a job twice on one simulated dataset: a
+// variant of its folder, and the pose differences they compare.
+#include <algorithm>
+#include <filesystem>
+
+#include "mlidar/core/conversions.hpp"
+#include "mlidar/core/se3.hpp"
+#include "mlidar/io/dataset.hpp"
+#include "mlidar/io/extrinsics_io.hpp"
+
+namespace mlidar::test {
+
+inline double rotation_deg(const SE3& a, const SE3& b) { return rad_to_deg((a.inverse() * b).log().tail<3>().norm()); }
+inline double translation_m(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
+
+/// A copy of the dataset folder `sim` at `out` (scans shared through a link,
+/// ground truth left out) with its LiDARs listed in reverse order and/or the
+/// true extrinsics as the initial ones.
+inline std::filesystem::path dataset_variant(const std::filesystem::path& sim, const std::filesystem::path& out, bool reverse,
+                                             bool true_extrinsics) {
+  std::filesystem::create_directories(out);
+  io::Dataset dataset = io::read_dataset_yaml(sim / "dataset.yaml");
+  if (reverse) std::reverse(dataset.lidars.begin(), dataset.lidars.end());
+  if (true_extrinsics) {
+    const io::Extrinsics truth = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
+    for (auto& lidar : dataset.lidars) lidar.initial_extrinsic = truth.find(lidar.name)->T_base_lidar;
+  }
+  dataset.groundtruth = {};
+  io::write_dataset_yaml(out / "dataset.yaml", dataset);
+  std::filesystem::copy_file(sim / dataset.times, out / dataset.times);
+  std::filesystem::create_directory_symlink(std::filesystem::absolute(sim / "scans"), out / "scans");
+  return out;
+}
+
+}  // namespace mlidar::test
