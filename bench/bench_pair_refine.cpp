@@ -27,8 +27,12 @@ void BM_PairRefineOpenCalib(benchmark::State& state) {
   }
   const auto ref = read_points(scene / "top-2022-02-15-17-36-04-449.pcd");
   const auto target = read_points(scene / "left-2022-02-15-17-36-04-414.pcd");
-  mlidar::SE3 T_init = mlidar::io::read_opencalib_initial_extrinsics(scene / "initial_extrinsic.txt")
-                           .find("device_1")->T_base_lidar;
+  const mlidar::io::Extrinsics initial = mlidar::io::read_opencalib_initial_extrinsics(scene / "initial_extrinsic.txt");
+  if (initial.find("device_1") == nullptr) {
+    state.SkipWithError("initial_extrinsic.txt has no device_1");
+    return;
+  }
+  mlidar::SE3 T_init = initial.find("device_1")->T_base_lidar;
   mlidar::calib::PairRefineConfig config;
   if (state.range(0) == 1) {
     T_init = mlidar::calib::refine_pair(ref, target, T_init, config).T_ref_target;

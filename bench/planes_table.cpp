@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -43,7 +44,9 @@ std::pair<double, double> mean_std(const std::vector<double>& v) {
 }
 
 void run_trial(const fs::path& dir, int frames, std::vector<Cell>& cells) {
-  const SE3 truth = mlidar::io::read_extrinsics(dir / "groundtruth" / "extrinsics.yaml").find("l2")->T_base_lidar;
+  const mlidar::io::Extrinsics truth_file = mlidar::io::read_extrinsics(dir / "groundtruth" / "extrinsics.yaml");
+  if (truth_file.find("l2") == nullptr) throw std::runtime_error(dir.string() + ": groundtruth/extrinsics.yaml has no LiDAR l2");
+  const SE3 truth = truth_file.find("l2")->T_base_lidar;
   const mlidar::calib::PlanesCalibrator calibrator{mlidar::calib::PlanesConfig{}};
   for (int k = 0; k < frames; ++k) {
     char name[32];

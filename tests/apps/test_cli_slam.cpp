@@ -110,7 +110,9 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   ASSERT_EQ(est2.poses.size(), est.poses.size());
   for (std::size_t k = 0; k < est.poses.size(); ++k)
     EXPECT_LT(translation_m(est.poses[k].T_world_base, est2.poses[k].T_world_base), 1e-3) << "frame " << k;
-  const SE3 T_est2 = io::read_extrinsics(run2 / "extrinsics.yaml").find("right")->T_base_lidar;  // a copy: the Extrinsics is a temporary
+  const io::Extrinsics estimate2 = io::read_extrinsics(run2 / "extrinsics.yaml");
+  ASSERT_NE(estimate2.find("right"), nullptr);
+  const SE3& T_est2 = estimate2.find("right")->T_base_lidar;
   EXPECT_LT(rotation_deg(T_est, T_est2), 0.01);
   EXPECT_LT(translation_m(T_est, T_est2), 1e-3);
 }

@@ -117,7 +117,7 @@ void emit_numbers(YAML::Emitter& out, const std::string& key, const auto& values
 
 }  // namespace
 
-const LidarExtrinsic* Extrinsics::find(const std::string& name) const {
+const LidarExtrinsic* Extrinsics::find(const std::string& name) const& {
   for (const auto& lidar : lidars) {
     if (lidar.name == name) return &lidar;
   }

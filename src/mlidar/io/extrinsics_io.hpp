@@ -24,7 +24,10 @@ struct LidarExtrinsic {
 struct Extrinsics {
   std::string base = "base";
   std::vector<LidarExtrinsic> lidars;  ///< file order
-  const LidarExtrinsic* find(const std::string& name) const;
+  /// nullptr when absent. Not on a temporary (`read_extrinsics(p).find(..)`
+  /// would dangle: two use-after-frees in tests came from that pattern).
+  const LidarExtrinsic* find(const std::string& name) const&;
+  const LidarExtrinsic* find(const std::string& name) const&& = delete;
 };
 
 /// Rejects unknown keys, quaternions off unit length by more than 1e-6,
