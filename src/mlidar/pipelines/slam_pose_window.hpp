@@ -6,8 +6,10 @@
 // Frames 0 and 1 keep the odometry's poses: at frame 1 the odometry moves its
 // world to the first stamp and rebuilds its map from both frames (deskewed
 // again); the window starts from a copy of that map and takes frames from 2
-// on. A lost frame (the odometry could not register it) is not added: it
-// keeps the odometry's pose, and its features were not mapped.
+// on, of which the first p fill its fixed part as given (so frames 0 to
+// p + 1 are the odometry's). A lost frame (the odometry could not register
+// it) is not added: it keeps the odometry's pose, and its features were not
+// mapped.
 //
 // Output: the pose of frame k is the window's estimate when k leaves the
 // variable part (settled: N + 1 - p solves, the last with the frames before

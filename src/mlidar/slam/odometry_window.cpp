@@ -1,6 +1,7 @@
 #include "mlidar/slam/odometry_window.hpp"
 
 #include <stdexcept>
+#include <utility>
 
 #include "mlidar/slam/marginalization.hpp"
 
