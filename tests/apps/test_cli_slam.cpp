@@ -58,7 +58,7 @@ nlohmann::json read_metrics(const fs::path& run) { return nlohmann::json::parse(
 
 void expect_documented_keys(const nlohmann::json& metrics, int frames) {
   EXPECT_EQ(metrics["frames"].get<int>(), frames);
-  for (const char* stage : {"load", "odometry", "initialization", "calibration", "shock"})
+  for (const char* stage : {"load", "odometry", "initialization", "calibration", "shock", "window"})
     for (const char* stat : {"mean", "p50", "p95", "max"}) EXPECT_TRUE(metrics["stages"][stage].contains(stat)) << stage << " " << stat;
   ASSERT_EQ(metrics["per_frame"].size(), static_cast<std::size_t>(frames));
   const auto& frame = metrics["per_frame"].back();
@@ -131,6 +131,21 @@ TEST(CliSlam, FixedModeIsTheOdometryAndMissingScansAreReported) {
   EXPECT_NEAR(slam_ate, ate_rmse(gt, io::read_tum(odometry / "trajectory.tum")), 1e-3);
   EXPECT_LT(slam_ate, kMaxAteM);
   EXPECT_EQ(read_metrics(run)["per_frame"].front()["mode"], "odometry");
+
+  // window.refine_odometry: one pose per frame at the same stamps, in order, as accurate (the window
+  // moves the poses by about 0.3 mm here: see docs/benchmarks.md, "Back end (issue 9)").
+  {
+    std::ofstream(dir / "window.yaml") << "window:\n  refine_odometry: true\n";
+    const fs::path windowed = dir / "windowed";
+    const CliResult result = run_cli("slam --dataset " + quoted(truth.string()) + " --calibrate fixed --config " +
+                                     quoted((dir / "window.yaml").string()) + " --out " + quoted(windowed.string()));
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+    const Trajectory plain = io::read_tum(run / "trajectory.tum"), refined = io::read_tum(windowed / "trajectory.tum");
+    ASSERT_EQ(refined.poses.size(), plain.poses.size());
+    for (std::size_t k = 0; k < plain.poses.size(); ++k) EXPECT_EQ(refined.poses[k].stamp, plain.poses[k].stamp) << k;
+    EXPECT_NEAR(ate_rmse(gt, refined), slam_ate, 2e-3);
+    EXPECT_GT(read_metrics(windowed)["stages"]["window"]["mean"].get<double>(), 0.0);
+  }
 
   // Frames 10-14 of the right LiDAR removed (the scans folder is the simulator's own, not the link).
   for (int k = 10; k < 15; ++k) {

@@ -37,7 +37,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 22u);
+  EXPECT_EQ(slam_config_keys().size(), 23u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -52,7 +52,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   SlamConfig c;
   c.initialization = {123, 0.5, 0.1 / 3.0, 0.07, 0.002};
   c.convergence = {65.5, 30};
-  c.window = {6, 3, 55.25, 10.0};
+  c.window = {6, 3, 55.25, 10.0, true};
   c.shock.history = 80;
   c.shock.min_history = 30;
   c.shock.threshold_mads = 3.5;
@@ -73,6 +73,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   EXPECT_EQ(back.convergence.accepted_needed, 30u);
   EXPECT_EQ(back.window.pivot, 3);
   EXPECT_FALSE(back.shock.relative_to_others);
+  EXPECT_TRUE(back.window.refine_odometry);
   EXPECT_EQ(back.odometry.registration.max_iterations, 12);
   EXPECT_EQ(back.odometry.registration.huber_delta_m, 0.05);
 }

@@ -169,6 +169,17 @@ TEST(Marginalization, FixedPoseLeavesAPriorOnTheExtrinsicAlone) {
   EXPECT_LT((prior.jacobian.transpose() * prior.residual - (J.transpose() * r).segment<6>(e)).norm(), 1e-9 * block.norm());
 }
 
+TEST(Marginalization, FixedPoseWithFixedExtrinsicsLeavesNoPrior) {
+  // Eq 4.22: every block the frame-0 terms touch is a constant (a crash before: a 0 x 0 Schur complement).
+  SmallWindow w = small_window(83);
+  w.problem.prior = {};
+  w.state.pose_fixed[0] = true;
+  set_extrinsic_mode(w.state, ExtrinsicMode::kFixed);
+  const LinearPrior prior = marginalize_frame(w.problem, w.state, 0, kHuberOff);
+  EXPECT_TRUE(prior.variables.empty());
+  EXPECT_EQ(prior.jacobian.rows(), 0);
+}
+
 TEST(Marginalization, ShiftReindexesThePriorAndKeepsItsValue) {
   SmallWindow w = small_window(91);
   const LinearPrior prior = marginalize_frame(w.problem, w.state, 0, kHuberOff);

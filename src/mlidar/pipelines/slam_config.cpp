@@ -59,6 +59,8 @@ std::vector<Field> fields(SlamConfig& c) {
        &c.window.uncertainty_threshold},
       {"window", "extrinsic_covariance_scale", {1.0, 1e6}, "alpha: scale of the extrinsic covariance",
        &c.window.extrinsic_covariance_scale},
+      {"window", "refine_odometry", {}, "refine the trusted odometry's poses in the N + 1 window (eq 4.22)",
+       &c.window.refine_odometry},
       {"shock", "history", {3, 1e5}, "normal frames in the robust baseline", &shock.history},
       {"shock", "min_history", {3, 1e5}, "no decision before this many (<= history)", &shock.min_history},
       {"shock", "threshold_mads", {0.0, 100.0, true, false}, "robust z-score of a high frame",

@@ -23,6 +23,8 @@ struct WindowParams {
   int pivot = 2;                            ///< p: the pivot state, origin of the local map, 1 <= p <= N
   double uncertainty_threshold = 100.0;     ///< w: threshold for filtering uncertain points in mapping
   double extrinsic_covariance_scale = 1.0;  ///< alpha >= 1: scale of the extrinsic covariance (10 under large perturbation)
+  /// Refine the trusted odometry's poses in the sliding window (eq 4.22, slam_pose_window.hpp).
+  bool refine_odometry = false;
 };
 
 struct SlamConfig {

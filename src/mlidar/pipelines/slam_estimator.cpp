@@ -116,6 +116,7 @@ SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> li
     }
   }
   odometry_ = std::make_unique<slam::Odometry>(config_.odometry, trusted_setups());
+  if (config_.window.refine_odometry) pose_window_.emplace(config_);
 }
 
 SlamEstimator::~SlamEstimator() = default;
@@ -251,6 +252,14 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   auto start = Clock::now();
   run_trusted_odometry(stamp, scans, out);
   out.seconds.odometry = seconds_since(start);
+  if (pose_window_) {
+    start = Clock::now();
+    if (const auto update = pose_window_->add(k, last_odometry_, *odometry_)) {
+      out.T_world_base = update->latest.T_world_base;
+      out.settled = update->settled;
+    }
+    out.seconds.window = seconds_since(start);
+  }
 
   trusted_changed_ = false;
   for (std::size_t j = 1; j < tracks_.size(); ++j) {
@@ -290,6 +299,10 @@ std::vector<SlamLidarReport> SlamEstimator::lidar_reports() const {
     reports.back().T_base_lidar = track->setup.T_base_lidar;
   }
   return reports;
+}
+
+std::vector<slam::WindowPose> SlamEstimator::unsettled_poses() const {
+  return pose_window_ ? pose_window_->unsettled() : std::vector<slam::WindowPose>{};
 }
 
 std::vector<Eigen::Vector3f> SlamEstimator::map_points() const {

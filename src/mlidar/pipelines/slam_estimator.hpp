@@ -34,6 +34,7 @@
 #include "mlidar/calib/online_hand_eye.hpp"
 #include "mlidar/calib/shock_detector.hpp"
 #include "mlidar/pipelines/slam_config.hpp"
+#include "mlidar/pipelines/slam_pose_window.hpp"
 #include "mlidar/slam/map_correspondences.hpp"
 #include "mlidar/slam/odometry.hpp"
 
@@ -55,6 +56,7 @@ struct SlamStageSeconds {
   double initialization = 0.0;  ///< untrusted LiDARs' own odometry and hand-eye
   double calibration = 0.0;     ///< calibrating LiDARs' front end, correspondences, window solve
   double shock = 0.0;           ///< per-LiDAR residuals and the trigger
+  double window = 0.0;          ///< the sliding window over the trusted poses (window.refine_odometry)
 };
 
 /// One LiDAR at one frame.
@@ -70,7 +72,8 @@ struct SlamLidarFrame {
 
 struct SlamFrame {
   double stamp = 0.0;
-  SE3 T_world_base;
+  SE3 T_world_base;  ///< the trusted odometry's, or the window's latest estimate (window.refine_odometry)
+  std::optional<slam::WindowPose> settled;  ///< window.refine_odometry: an earlier frame's final pose
   bool calibrating = false;  ///< some LiDAR not trusted after this frame (online-calibration mode), else pure odometry
   bool lost = false;         ///< the trusted odometry could not register this frame
   bool trusted_changed = false;  ///< the trusted set changes from the next frame on
@@ -108,6 +111,8 @@ class SlamEstimator {
   SlamFrame process(double stamp, const std::vector<std::optional<Scan>>& scans);
 
   std::vector<SlamLidarReport> lidar_reports() const;
+  /// window.refine_odometry: the frames whose pose has not settled yet, at their latest estimates.
+  std::vector<slam::WindowPose> unsettled_poses() const;
   /// The current local maps (planes then edges) in the world frame.
   std::vector<Eigen::Vector3f> map_points() const;
 
@@ -129,6 +134,7 @@ class SlamEstimator {
   std::unique_ptr<slam::Odometry> odometry_;  ///< over the trusted LiDARs
   std::vector<std::size_t> trusted_;          ///< indices in odometry_'s LiDAR order
   slam::FrameResult last_odometry_;
+  std::optional<SlamPoseWindow> pose_window_;  ///< window.refine_odometry
   bool trusted_changed_ = false;
   std::size_t frames_ = 0;
 };

@@ -91,9 +91,11 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
     const auto scans = load_frame(in, k);
     load_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     frames.push_back(estimator.process(in.stamps[k], scans));
+    if (const auto& settled = frames.back().settled) frames.at(settled->frame).T_world_base = settled->T_world_base;
     if (progress) progress(static_cast<int>(k + 1), static_cast<int>(in.stamps.size()));
   }
 
+  for (const slam::WindowPose& pose : estimator.unsettled_poses()) frames.at(pose.frame).T_world_base = pose.T_world_base;
   SlamJobSummary summary;
   summary.frames = frames.size();
   const std::vector<SlamLidarReport> reports = estimator.lidar_reports();
@@ -103,7 +105,7 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
     summary.trajectory.poses.push_back({f.stamp, f.T_world_base});
     summary.lost_frames += f.lost ? 1 : 0;
     const auto& s = f.seconds;
-    summary.mean_frame_seconds += (s.odometry + s.initialization + s.calibration + s.shock) / static_cast<double>(frames.size());
+    summary.mean_frame_seconds += (s.odometry + s.initialization + s.calibration + s.shock + s.window) / static_cast<double>(frames.size());
   }
   std::filesystem::create_directories(job.out);
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);

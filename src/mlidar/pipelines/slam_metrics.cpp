@@ -13,17 +13,19 @@ nlohmann::json optional_json(const std::optional<T>& value) {
 }
 
 nlohmann::json stage_timings(const std::vector<SlamFrame>& frames, const std::vector<double>& load_seconds, nlohmann::json& total) {
-  std::vector<double> odometry, initialization, calibration, shock, sum;
+  std::vector<double> odometry, initialization, calibration, shock, window, sum;
   for (const auto& f : frames) {
     odometry.push_back(f.seconds.odometry);
     initialization.push_back(f.seconds.initialization);
     calibration.push_back(f.seconds.calibration);
     shock.push_back(f.seconds.shock);
-    sum.push_back(f.seconds.odometry + f.seconds.initialization + f.seconds.calibration + f.seconds.shock);
+    window.push_back(f.seconds.window);
+    sum.push_back(f.seconds.odometry + f.seconds.initialization + f.seconds.calibration + f.seconds.shock + f.seconds.window);
   }
   total = timing_summary(sum);
   return {{"load", timing_summary(load_seconds)}, {"odometry", timing_summary(odometry)}, {"initialization", timing_summary(initialization)},
-          {"calibration", timing_summary(calibration)}, {"shock", timing_summary(shock)}};
+          {"calibration", timing_summary(calibration)}, {"shock", timing_summary(shock)},
+          {"window", timing_summary(window)}};
 }
 
 nlohmann::json pose_json(const SE3& T) {

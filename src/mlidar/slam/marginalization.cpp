@@ -79,6 +79,7 @@ LinearPrior marginalize_frame(const WindowProblem& problem, const WindowState& s
                [frame](const EdgeCorrespondence& c) { return c.frame == frame; });
   terms.prior = problem.prior;
   const std::vector<VariableId> ids = involved_variables(terms, state, frame);
+  if (ids.empty()) return {};  // a fixed pose whose terms touch no variable: nothing to carry
   const WindowState local = restricted_to(state, ids);
   const VariableLayout layout(local);
   const WindowLinearSystem system = linearize_window(terms, local, layout, huber_delta_m);
