@@ -4,7 +4,10 @@
 # motion through SCENE, the dataset's extrinsic perturbed by 5 deg / 0.1 m
 # (unused by --calibrate online), SEEDS seeds. One markdown row per seed and a
 # summary: ATE (SE(3)-aligned, m), right LiDAR's rotation / translation error,
-# converged frame, ms per frame (estimator only).
+# converged frame, ms per frame (estimator only), NEES of the right LiDAR's
+# extrinsic under its reported covariance (6 dof; 95 % bound 12.59; null when
+# not converged) and its 1-sigma (sqrt of the covariance's diagonal: rotation
+# deg as the largest of three, translation m likewise).
 #   experiments/slam_protocol.sh BUILD_DIR SCENE FRAMES SEEDS WORK_DIR
 set -euo pipefail
 build=${1:?BUILD_DIR}; scene=${2:?SCENE}; frames=${3:?FRAMES}; seeds=${4:?SEEDS}; work=${5:?WORK_DIR}
@@ -27,8 +30,8 @@ lidars:
     translation: [0, -0.477, -0.220]
     rotation_rpy_deg: [40, 0, 0]
 YAML
-echo "| seed | ATE m | rot err deg | trans err m | converged frame | ms/frame | exit |"
-echo "|---|---|---|---|---|---|---|"
+echo "| seed | ATE m | rot err deg | trans err m | converged frame | ms/frame | exit | NEES | 1-sigma rot deg / trans m |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for seed in $(seq 1 "$seeds"); do
   sim="$work/$scene-$seed"; run="$work/run-$scene-$seed"
   rm -rf "$sim" "$run"
@@ -41,5 +44,9 @@ for seed in $(seq 1 "$seeds"); do
   trans=$(jq '.lidars[] | select(.name == "right") | .translation_error_m' "$run/calib.json")
   conv=$(jq '.per_lidar.right.converged_frame' "$run/metrics.json")
   ms=$(jq '.total_seconds.mean * 1000' "$run/metrics.json")
-  printf "| %s | %.4f | %.3f | %.4f | %s | %.0f | %s |\n" "$seed" "$ate" "$rot" "$trans" "$conv" "$ms" "$code"
+  nees=$(jq '.lidars[] | select(.name == "right") | .nees' "$run/calib.json")
+  sigma=$(jq -r '.per_lidar.right.covariance | if . == null then "-" else
+    ([.[21], .[28], .[35]] | map(sqrt * 57.29578) | max | tostring | .[0:6]) + " / " +
+    ([.[0], .[7], .[14]] | map(sqrt) | max | tostring | .[0:6]) end' "$run/metrics.json")
+  printf "| %s | %.4f | %.3f | %.4f | %s | %.0f | %s | %s | %s |\n" "$seed" "$ate" "$rot" "$trans" "$conv" "$ms" "$code" "$nees" "$sigma"
 done

@@ -63,10 +63,11 @@ void expect_documented_keys(const nlohmann::json& metrics, int frames) {
   ASSERT_EQ(metrics["per_frame"].size(), static_cast<std::size_t>(frames));
   const auto& frame = metrics["per_frame"].back();
   for (const char* key : {"stamp", "mode", "lost", "trusted_changed", "lidars"}) EXPECT_TRUE(frame.contains(key)) << key;
-  for (const char* key : {"role", "scan_missing", "lambda_min", "accepted", "window_estimate", "mean_residual_m", "shock"})
+  for (const char* key : {"role", "scan_missing", "lambda_min", "accepted", "window_estimate", "mean_residual_m", "shock",
+                          "window_information", "window_residual_variance_m2"})
     EXPECT_TRUE(frame["lidars"]["right"].contains(key)) << key;
   for (const char* key : {"role", "translation", "quaternion_wxyz", "covariance", "initialization", "converged_frame", "accepted",
-                          "restarts", "shock_frames", "missing_frames", "weak_directions"})
+                          "restarts", "shock_frames", "missing_frames", "weak_directions", "covariance_terms"})
     EXPECT_TRUE(metrics["per_lidar"]["right"].contains(key)) << key;
 }
 
@@ -101,6 +102,8 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   EXPECT_FALSE(right["initialization"]["planar_motion"].get<bool>());
   EXPECT_EQ(right["accepted"].get<int>(), 25);  // L_calib (Table 4.2)
   EXPECT_LT(right["converged_frame"].get<int>(), kFrames);
+  // Xi_calib's autocorrelation time is at least the window's N + 1 = 5 frames (clamped to L_calib).
+  EXPECT_GE(right["covariance_terms"]["autocorrelation_time"].get<double>(), 5.0);
 
   // The same data with the LiDARs listed in reverse order.
   const fs::path reversed = dataset_variant(sim, dir / "reversed", true, false);

@@ -70,9 +70,28 @@ TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   EXPECT_FALSE(ignored.accepted);  // calibration has stopped
   EXPECT_EQ(monitor.lidar(0).T_base_lidar.translation(), converged.translation());
   const ExtrinsicMean direct = extrinsic_mean(monitor.lidar(0).accepted);
-  EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(direct.covariance, 1e-12));
-  EXPECT_LT(monitor.lidar(0).covariance.diagonal().maxCoeff(), 4.0 * 0.01 * 0.01);
-  EXPECT_GT(monitor.lidar(0).covariance.diagonal().minCoeff(), 0.25 * 0.01 * 0.01);
+  // No residual variance given: Xi_calib is the scatter term alone, the
+  // variance of the mean of 25 independent estimates (sigma^2 / 25, tau ~ 1).
+  EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(calibration_covariance(direct.local_deviations, {}, 1.0).total, 1e-12));
+  EXPECT_TRUE(monitor.lidar(0).covariance_parts.windows.isZero());
+  EXPECT_LT(monitor.lidar(0).covariance_parts.autocorrelation_time, 3.0);
+  EXPECT_LT(monitor.lidar(0).covariance.diagonal().maxCoeff(), 3.0 * 4.0 * 0.01 * 0.01 / 25);
+  EXPECT_GT(monitor.lidar(0).covariance.diagonal().minCoeff(), 0.25 * 0.01 * 0.01 / 25);
+}
+
+TEST(ConvergenceMonitor, WindowCovariancesEnterXiCalibWhenTheResidualVarianceIsGiven) {
+  ConvergenceConfig config;
+  config.accepted_needed = 4;
+  config.min_autocorrelation_time = 5.0;
+  ConvergenceMonitor monitor({kTruth}, config);
+  const Mat6 information = information_with_min(100.0, 2);
+  for (int window = 0; window < 4; ++window) monitor.add_window(0, kTruth, information, 1e-3);
+  ASSERT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
+  // Identical estimates: no scatter; Xi_calib is one window's sigma^2 Lambda^-1 in the local tangent.
+  const Mat6 expected = local_covariance_from_left_information(kTruth, information, 1e-3);
+  EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(expected, 1e-9));
+  EXPECT_DOUBLE_EQ(monitor.lidar(0).covariance_parts.autocorrelation_time, 4.0);  // the floor 5 clamped to n
+  EXPECT_THROW(ConvergenceMonitor({kTruth}, ConvergenceConfig{70.0, 25, 0.5}), std::invalid_argument);
 }
 
 TEST(ExtrinsicMean, SymmetricSamplesGiveTheCentreAndTheAnalyticCovariance) {

@@ -80,12 +80,13 @@ ExtrinsicMean extrinsic_mean(std::span<const SE3> samples) {
     t_mean += T.translation();
   }
   t_mean /= static_cast<double>(samples.size());
-  ExtrinsicMean result{SE3(karcher_mean(rotations), t_mean), Mat6::Zero()};
+  ExtrinsicMean result{SE3(karcher_mean(rotations), t_mean), Mat6::Zero(), {}};
   if (samples.size() < 2) return result;
   for (const SE3& T : samples) {
     Vec6 d;
     d << T.translation() - t_mean, so3_log(T.rotation() * result.mean.rotation().conjugate());
     result.covariance += d * d.transpose();
+    result.local_deviations.push_back((Vec6() << d.head<3>(), so3_log(result.mean.rotation().conjugate() * T.rotation())).finished());
   }
   result.covariance /= static_cast<double>(samples.size() - 1);
   return result;
@@ -100,8 +101,8 @@ std::string_view to_string(CalibrationMode mode) {
 }
 
 ConvergenceMonitor::ConvergenceMonitor(std::vector<SE3> initial, ConvergenceConfig config) : config_(config) {
-  if (initial.empty() || config_.accepted_needed < 2 || !(config_.lambda_calib > 0.0)) {
-    throw std::invalid_argument("ConvergenceMonitor: needs >= 1 LiDAR, accepted_needed >= 2, lambda_calib > 0");
+  if (initial.empty() || config_.accepted_needed < 2 || !(config_.lambda_calib > 0.0) || !(config_.min_autocorrelation_time >= 1.0)) {
+    throw std::invalid_argument("ConvergenceMonitor: needs >= 1 LiDAR, accepted_needed >= 2, lambda_calib > 0, min_autocorrelation_time >= 1");
   }
   for (const SE3& T : initial) {
     LidarCalibrationState state;
@@ -110,7 +111,7 @@ ConvergenceMonitor::ConvergenceMonitor(std::vector<SE3> initial, ConvergenceConf
   }
 }
 
-WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information) {
+WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information, double residual_variance) {
   LidarCalibrationState& state = lidars_.at(lidar);
   WindowVerdict verdict;
   if (state.mode == CalibrationMode::converged) return verdict;  // line 2: calibration has stopped
@@ -130,11 +131,16 @@ WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_bas
   verdict.accepted = true;
   state.T_base_lidar = T_base_lidar;
   state.accepted.push_back(T_base_lidar);
+  if (residual_variance > 0.0 && std::isfinite(residual_variance))
+    state.accepted_covariances.push_back(local_covariance_from_left_information(T_base_lidar, information, residual_variance));
   if (state.accepted.size() < config_.accepted_needed) return verdict;
-  // Lines 8-11: mean, covariance, stop.
+  // Lines 8-11: mean, covariance, stop. The windows' term only when every accepted window gave one.
   const ExtrinsicMean mean = extrinsic_mean(state.accepted);
   state.T_base_lidar = mean.mean;
-  state.covariance = mean.covariance;
+  const bool all_windows = state.accepted_covariances.size() == state.accepted.size();
+  state.covariance_parts = calibration_covariance(mean.local_deviations, all_windows ? std::span<const Mat6>(state.accepted_covariances) : std::span<const Mat6>(),
+                                                  config_.min_autocorrelation_time);
+  state.covariance = state.covariance_parts.total;
   state.mode = CalibrationMode::converged;
   verdict.converged_now = true;
   return verdict;
@@ -144,7 +150,9 @@ void ConvergenceMonitor::restart(std::size_t lidar) {
   LidarCalibrationState& state = lidars_.at(lidar);
   state.mode = CalibrationMode::calibrating;
   state.accepted.clear();
+  state.accepted_covariances.clear();
   state.covariance = Mat6::Zero();
+  state.covariance_parts = {};
   state.weak.clear();
   ++state.restarts;
 }

@@ -4,7 +4,12 @@
 // the 6x6 information matrix Lambda = J^T J of eq 4.21 w.r.t. that extrinsic:
 //   lambda = smallest eigenvalue of Lambda (the degeneracy factor);
 //   lambda > lambda_calib  -> the estimate is accepted (set as the system's extrinsic);
-//   L_calib accepted       -> mean and sample covariance Xi_calib, calibration stops.
+//   L_calib accepted       -> mean and covariance Xi_calib, calibration stops.
+// Xi_calib is calib::calibration_covariance (extrinsic_covariance.hpp): the
+// accepted estimates' scatter over their effective sample size (overlapping
+// windows are autocorrelated) plus the windows' own mean covariance
+// sigma^2 Lambda^-1 (when the caller gives the residual variance), in the
+// tangent of extrinsics.yaml: [t additive, r local].
 // (The thesis tests |L| > L_calib; here exactly L_calib accepted estimates
 // converge, so `accepted_needed` is the sample size.) The eigenvectors of
 // Lambda below lambda_calib are reported in words: the directions the motion
@@ -18,6 +23,7 @@
 #include <string_view>
 #include <vector>
 
+#include "mlidar/calib/extrinsic_covariance.hpp"
 #include "mlidar/core/se3.hpp"
 
 namespace mlidar::calib {
@@ -25,6 +31,9 @@ namespace mlidar::calib {
 struct ConvergenceConfig {
   double lambda_calib = 70.0;          ///< accept a window's estimate when lambda_min exceeds it
   std::size_t accepted_needed = 25;    ///< L_calib: accepted estimates averaged at convergence
+  /// Floor of the accepted estimates' autocorrelation time in Xi_calib: the
+  /// frames a window spans (N + 1), as consecutive windows share N of them.
+  double min_autocorrelation_time = 1.0;
 };
 
 /// One eigen-direction of an information matrix.
@@ -48,6 +57,7 @@ std::string describe_direction(const Vec6& direction);
 struct ExtrinsicMean {
   SE3 mean;
   Mat6 covariance = Mat6::Zero();
+  std::vector<Vec6> local_deviations;  ///< per sample [t_i - t_mean, Log(R_mean^-1 R_i)] (rotation local)
 };
 /// Throws std::invalid_argument for an empty set.
 ExtrinsicMean extrinsic_mean(std::span<const SE3> samples);
@@ -65,8 +75,10 @@ struct WindowVerdict {
 struct LidarCalibrationState {
   CalibrationMode mode = CalibrationMode::calibrating;
   std::vector<SE3> accepted;            ///< the set L (cleared at restart)
+  std::vector<Mat6> accepted_covariances;  ///< their own covariances ([t, r local]) when given
   SE3 T_base_lidar;                     ///< last accepted estimate; the mean once converged
-  Mat6 covariance = Mat6::Zero();       ///< Xi_calib once converged
+  Mat6 covariance = Mat6::Zero();       ///< Xi_calib once converged ([t additive, r local])
+  CalibrationCovariance covariance_parts;  ///< its terms once converged
   double last_lambda_min = 0.0;
   std::size_t windows = 0;              ///< windows seen while calibrating
   std::size_t restarts = 0;             ///< restart() calls (re-calibrations)
@@ -82,7 +94,9 @@ class ConvergenceMonitor {
   /// Algorithm 1 for one window of LiDAR `lidar` (< size()). A converged
   /// LiDAR ignores windows (calibration stopped): the verdict says not accepted.
   /// A non-finite estimate or information is never accepted.
-  WindowVerdict add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information);
+  /// `residual_variance` (> 0: the window's sigma^2 per residual row) makes the
+  /// window's own covariance sigma^2 information^-1 part of Xi_calib; 0: unknown.
+  WindowVerdict add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information, double residual_variance = 0.0);
 
   /// Back to calibrating from the current extrinsic, L emptied (the re-calibration trigger).
   void restart(std::size_t lidar);

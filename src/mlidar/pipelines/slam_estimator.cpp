@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "mlidar/calib/ground_up.hpp"
 #include "mlidar/slam/calibration_window.hpp"
 
 namespace mlidar::pipelines {
@@ -37,6 +38,12 @@ Frame trusted_frame(double stamp, const std::vector<std::optional<Scan>>& scans,
     if (!scans[j]) frame.scans.back().stamp = stamp;
   }
   return frame;
+}
+
+/// Xi_calib's autocorrelation floor: a window spans N + 1 frames, consecutive ones share N.
+calib::ConvergenceConfig with_window_overlap(calib::ConvergenceConfig config, int window_size) {
+  config.min_autocorrelation_time = window_size + 1.0;
+  return config;
 }
 
 slam::LidarSetup with_extrinsic(slam::LidarSetup setup, const SE3& T_base_lidar) {
@@ -100,7 +107,7 @@ struct SlamEstimator::Track {
 SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source)
     : config_(std::move(config)),
       source_(source),
-      monitor_(std::vector<SE3>(lidars.size(), SE3::identity()), config_.convergence),
+      monitor_(std::vector<SE3>(lidars.size(), SE3::identity()), with_window_overlap(config_.convergence, config_.window.size)),
       shock_(lidars.size(), config_.shock) {
   if (lidars.empty()) throw std::invalid_argument("SlamEstimator: no LiDARs");
   for (std::size_t j = 0; j < lidars.size(); ++j) {
@@ -187,9 +194,11 @@ void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std
       slam::solve_calibration_window(track.window, track.setup.T_base_lidar, map, kCalibrationGatesM, config_.odometry.registration.huber_delta_m);
   if (!window.solved) return;
   out.mean_residual_m = window.fit.mean_residual_m();
-  const calib::WindowVerdict verdict = monitor_.add_window(j, window.T_base_lidar, window.information);
+  const calib::WindowVerdict verdict = monitor_.add_window(j, window.T_base_lidar, window.information, window.residual_variance_m2);
   out.lambda_min = verdict.lambda_min;
   out.window_estimate = window.T_base_lidar;
+  out.window_information = window.information;
+  out.window_residual_variance_m2 = window.residual_variance_m2;
   out.accepted = verdict.accepted;
   track.report.weak = monitor_.lidar(j).weak;
   if (verdict.accepted) track.setup.T_base_lidar = window.T_base_lidar;
@@ -198,6 +207,7 @@ void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std
   // Algorithm 1 lines 8-11: the mean of L_calib accepted estimates, covariance alpha Xi_calib.
   track.setup.T_base_lidar = monitor_.lidar(j).T_base_lidar;
   track.report.covariance = config_.window.extrinsic_covariance_scale * monitor_.lidar(j).covariance;
+  track.report.covariance_parts = monitor_.lidar(j).covariance_parts;
   track.report.converged_frame = frame_index;
   track.role = LidarRole::trusted;
   track.window.clear();
@@ -213,11 +223,24 @@ void SlamEstimator::make_untrusted(std::size_t j) {
   track.hand_eye.reset();
   monitor_.restart(j);
   track.T_g_lidar = SE3(track.setup.T_base_lidar.rotation(), Vec3::Zero());
-  track.own = std::make_unique<slam::Odometry>(config_.odometry, std::vector{with_extrinsic(track.setup, track.T_g_lidar)});
+  track.own.reset();  // restarted at its next scan, with up from that scan's ground (restart_own_odometry)
   track.recent.clear();
   track.report.covariance.reset();
+  track.report.covariance_parts.reset();
   ++track.report.restarts;
   trusted_changed_ = true;
+}
+
+void SlamEstimator::restart_own_odometry(std::size_t j, const Scan& scan) {
+  Track& track = *tracks_[j];
+  // After a shock the old extrinsic's up is off by up to the shock's tilt
+  // (~14 deg in Table 4.6), beyond the ground segmentation's 10 deg: its own
+  // odometry then drifted and the hand-eye kept 14 of ~110 pairs in 116
+  // frames (rhd campus, seed 1). The ground plane of the scan near that up corrects it.
+  const Vec3 prior_up = track.T_g_lidar.rotation().conjugate() * Vec3::UnitZ();
+  if (const std::optional<Vec3> up = calib::ground_up(scan.points, prior_up))
+    track.T_g_lidar = SE3(calib::align_up(track.T_g_lidar.rotation(), *up), Vec3::Zero());
+  track.own = std::make_unique<slam::Odometry>(config_.odometry, std::vector{with_extrinsic(track.setup, track.T_g_lidar)});
 }
 
 void SlamEstimator::detect_shocks(std::size_t frame_index, SlamFrame& out) {
@@ -270,6 +293,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
     }
     start = Clock::now();
     if (tracks_[j]->role == LidarRole::initializing) {
+      if (!tracks_[j]->own) restart_own_odometry(j, *scans[j]);
       initialize(j, stamp, *scans[j], k, out.lidars[j]);
       out.seconds.initialization += seconds_since(start);
     } else if (tracks_[j]->role == LidarRole::calibrating && !last_odometry_.lost) {

@@ -14,10 +14,14 @@
 //     matched against that map and the window is solved for T_base_lidar_j;
 //     (estimate, information) go to Algorithm 1 (calib::ConvergenceMonitor):
 //     accepted estimates become j's extrinsic; on convergence j joins the
-//     trusted set with covariance alpha Xi_calib;
+//     trusted set with covariance alpha Xi_calib (calib::calibration_covariance:
+//     the accepted estimates' scatter over their effective sample size, tau
+//     at least N + 1, plus the windows' own sigma^2 Lambda^-1);
 //   - extrinsic shock: each trusted LiDAR's mean residual against the map per
 //     frame feeds calib::ShockDetector; a trigger sends that LiDAR back to
-//     initialization (hand-eye and Algorithm 1 restarted).
+//     initialization (hand-eye and Algorithm 1 restarted; its own odometry
+//     restarted at its next scan with up from that scan's ground, as the
+//     shock tilted the old extrinsic's up).
 // A change of the trusted set takes effect at the next frame
 // (Odometry::set_lidars): the world, the pose history and the local map are
 // kept (an earlier version restarted the odometry and its map there; the
@@ -66,6 +70,8 @@ struct SlamLidarFrame {
   double lambda_min = -1.0;        ///< smallest extrinsic-information eigenvalue of its window (-1: no window)
   bool accepted = false;           ///< Algorithm 1 accepted this window's estimate
   std::optional<SE3> window_estimate;  ///< T_base_lidar of this frame's window (accepted or not)
+  std::optional<Mat6> window_information;  ///< its extrinsic information ([t, r], left perturbation, 1/m^2)
+  double window_residual_variance_m2 = -1.0;  ///< its residual variance per row (-1: no window)
   double mean_residual_m = -1.0;   ///< against the map (-1: none)
   bool shock = false;              ///< the re-calibration trigger fired
 };
@@ -86,7 +92,8 @@ struct SlamLidarReport {
   std::string name;
   LidarRole role = LidarRole::initializing;
   SE3 T_base_lidar;                    ///< current extrinsic
-  std::optional<Mat6> covariance;      ///< alpha Xi_calib once converged
+  std::optional<Mat6> covariance;      ///< alpha Xi_calib once converged ([t additive, r local], as extrinsics.yaml)
+  std::optional<calib::CalibrationCovariance> covariance_parts;  ///< Xi_calib's terms (before alpha) once converged
   calib::OnlineHandEyeStatus initialization;
   std::optional<std::size_t> initialized_frame;  ///< last hand-eye completion
   std::optional<std::size_t> converged_frame;    ///< last convergence
@@ -125,6 +132,8 @@ class SlamEstimator {
   void calibrate(std::size_t j, double stamp, const Scan& scan, std::size_t frame_index, SlamLidarFrame& out);
   void detect_shocks(std::size_t frame_index, SlamFrame& out);
   void make_untrusted(std::size_t j);
+  /// A new own odometry for initializing LiDAR j, its up from `scan`'s ground near the old one.
+  void restart_own_odometry(std::size_t j, const Scan& scan);
 
   SlamConfig config_;
   ExtrinsicSource source_;

@@ -36,7 +36,19 @@ nlohmann::json pose_json(const SE3& T) {
 
 nlohmann::json lidar_frame_json(const SlamLidarFrame& l) {
   return {{"window_estimate", l.window_estimate ? pose_json(*l.window_estimate) : nlohmann::json(nullptr)}, {"role", std::string(to_string(l.role))}, {"scan_missing", l.scan_missing}, {"lambda_min", number_or_null(l.lambda_min)},
-          {"accepted", l.accepted}, {"mean_residual_m", number_or_null(l.mean_residual_m)}, {"shock", l.shock}};
+          {"accepted", l.accepted}, {"mean_residual_m", number_or_null(l.mean_residual_m)}, {"shock", l.shock},
+          {"window_information", l.window_information ? nlohmann::json(std::vector<double>(l.window_information->data(), l.window_information->data() + 36))
+                                                      : nlohmann::json(nullptr)},
+          {"window_residual_variance_m2", number_or_null(l.window_residual_variance_m2)}};
+}
+
+nlohmann::json matrix_json_6(const Mat6& m) { return std::vector<double>(m.data(), m.data() + 36); }
+
+/// Xi_calib's terms (calib/extrinsic_covariance.hpp), null before convergence.
+nlohmann::json covariance_terms_json(const std::optional<calib::CalibrationCovariance>& parts) {
+  if (!parts) return nullptr;
+  return {{"autocorrelation_time", parts->autocorrelation_time}, {"spread", matrix_json_6(parts->spread)},
+          {"windows", matrix_json_6(parts->windows)}};
 }
 
 nlohmann::json lidar_report_json(const SlamLidarReport& l) {
@@ -51,6 +63,7 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
           {"translation", {t.x(), t.y(), t.z()}},
           {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
           {"covariance", covariance},
+          {"covariance_terms", covariance_terms_json(l.covariance_parts)},
           {"initialization",
            {{"state", std::string(calib::to_string(init.state))},
             {"frame", optional_json(l.initialized_frame)},

@@ -28,6 +28,8 @@ CalibrationWindowResult solve_calibration_window(std::span<const CalibrationFram
     const WindowSolution solution = solve_window(problem, state, solver);
     state = solution.state;
     result.information = solution.extrinsic_information[1];
+    const double rows = static_cast<double>(problem.planes.size() + 2 * problem.edges.size());
+    result.residual_variance_m2 = rows > 6.0 ? 2.0 * solution.final_cost / (rows - 6.0) : 0.0;
   }
   result.solved = true;
   result.T_base_lidar = state.T_base_lidar[1];

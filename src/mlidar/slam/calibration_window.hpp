@@ -23,6 +23,10 @@ struct CalibrationWindowResult {
   SE3 T_base_lidar;                ///< the estimate (the start when not solved)
   Mat6 information = Mat6::Zero(); ///< of the extrinsic, [t, r], left perturbation in the base frame
   MapFit fit;                      ///< of the correspondences at the last gate
+  /// Residual variance per row at the solution, 2 F / (rows - 6) (F: the
+  /// Huber cost, a plane one row, an edge two): sigma^2 with which
+  /// sigma^2 information^-1 is the window's own covariance of the estimate.
+  double residual_variance_m2 = 0.0;
 };
 
 /// `gates_m`: correspondence gates (m), one re-matching pass each; `huber_delta_m`: the window's Huber scale.
