@@ -97,6 +97,7 @@ nlohmann::json report_json(const calib::PairRefineResult& r, double overlap_radi
           {"T_ref_target_initial", pose_json(r.T_init)},
           {"T_ref_target", pose_json(r.T_ref_target)},
           {"covariance", row_major(r.covariance)},
+          {"covariance_icp", row_major(r.covariance_icp)},
           {"information", row_major(r.information)},
           {"rotation_sd_deg", r.rotation_sd_deg},
           {"translation_sd_m", r.translation_sd_m},

@@ -49,6 +49,15 @@ Mat6 additive_translation_covariance(const Mat6& left, const Vec3& t) {
   return 0.5 * (covariance + covariance.transpose());  // exactly symmetric for the YAML writer/reader
 }
 
+/// Diagonal per-scene systematic term of the reported covariance (config, 1-sigma per axis).
+Mat6 systematic_covariance(const PairRefineConfig& config) {
+  const double rotation_var = std::pow(deg_to_rad(config.systematic_rotation_sd_deg), 2);
+  const double translation_var = std::pow(config.systematic_translation_sd_m, 2);
+  Vec6 diagonal;
+  diagonal << Vec3::Constant(translation_var), Vec3::Constant(rotation_var);
+  return diagonal.asDiagonal();
+}
+
 double largest_sd(const Mat3& block) {
   return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat3>(block).eigenvalues()(2)));
 }
@@ -107,6 +116,8 @@ std::vector<Eigen::Vector3f> beyond(std::span<const Eigen::Vector3f> points, dou
 void check_config(const PairRefineConfig& config) {
   if (!(config.min_range >= 0.0) || !(config.ref_voxel_size > 0.0) || !(config.search_ref_voxel_size > 0.0) || !(config.overlap_radius > 0.0) || !(config.fitness_voxel_size > 0.0))
     throw std::invalid_argument("refine_pair: voxel sizes and overlap_radius must be > 0");
+  if (!(config.systematic_rotation_sd_deg >= 0.0) || !(config.systematic_translation_sd_m >= 0.0))
+    throw std::invalid_argument("refine_pair: systematic sd must be >= 0");
   if (config.search_finalists == 0) throw std::invalid_argument("refine_pair: search_finalists must be >= 1");
 }
 
@@ -184,7 +195,8 @@ PairRefineResult refine_pair(std::span<const Eigen::Vector3f> ref, std::span<con
   result.T_ref_target = best.icp.T_ref_source;
   result.chosen_start = best.label;
   result.information = best.icp.information;
-  result.covariance = additive_translation_covariance(best.icp.covariance, result.T_ref_target.translation());
+  result.covariance_icp = additive_translation_covariance(best.icp.covariance, result.T_ref_target.translation());
+  result.covariance = result.covariance_icp + systematic_covariance(config);
   result.rotation_sd_deg = rad_to_deg(largest_sd(result.covariance.bottomRightCorner<3, 3>()));
   result.translation_sd_m = largest_sd(result.covariance.topLeftCorner<3, 3>());
   result.rmse = best.icp.rmse;

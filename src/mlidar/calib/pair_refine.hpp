@@ -44,6 +44,12 @@ struct PairRefineConfig {
   double ambiguity_margin = 0.03;       ///< a different pose this close in overlap makes the answer ambiguous
   double distinct_rotation_deg = 2.0;   ///< poses farther apart than this (or distinct_translation_m) are different
   double distinct_translation_m = 0.2;
+  // Per-scene systematic error added to the reported covariance (1-sigma per axis): what one
+  // pair of single scans cannot see from its own residuals (capture-time offsets between the
+  // LiDARs, motion during the sweep, surface sampling). Default: the pooled per-axis scatter of
+  // the three opencalib_3lidar scenes, left and right (docs/benchmarks.md, "Pairwise refinement").
+  double systematic_rotation_sd_deg = 0.12;
+  double systematic_translation_sd_m = 0.0125;
 };
 
 /// One start of the search, after its short ICP.
@@ -61,7 +67,8 @@ struct PairRefineResult {
   SE3 T_init;
   SE3 T_ref_target;
   Mat6 information = Mat6::Zero();    ///< J^T W J of the final ICP, left perturbation [rho, phi]
-  Mat6 covariance = Mat6::Zero();     ///< [t, r]: t additive, r as a left perturbation Exp(d) R
+  Mat6 covariance = Mat6::Zero();     ///< [t, r]: t additive, r as a left perturbation Exp(d) R; covariance_icp + systematic term
+  Mat6 covariance_icp = Mat6::Zero(); ///< same frame, the ICP's s^2 H^-1 alone (points independent: over-confident)
   double rotation_sd_deg = 0.0;       ///< sqrt of the largest eigenvalue of the rotation block
   double translation_sd_m = 0.0;      ///< same for the translation block
   double rmse = 0.0;                  ///< m
