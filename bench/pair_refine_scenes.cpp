@@ -10,7 +10,8 @@
 //   restarts=N       restart the last two ICP levels N times from the answer
 //                    moved by 0.5 deg / 5 cm (seeded): how sharp the minimum is
 //   reverse=1        also register the reference to the target from the answer
-//                    (roles swapped, no search) and print how far it lands
+//                    (roles swapped, no search), print how far it lands and
+//                    the spread of the reverse answers and of the midpoints
 //   yaw_rate_0001=W  deskew scene 0001's top scan by a yaw rate W deg/s about
 //                    its middle (a what-if for ego-motion; none is measured)
 #include <array>
@@ -149,7 +150,7 @@ int main(int argc, char** argv) {
     }
   }
   const std::array<std::string, 3> scenes{"0001", "0002", "0003"};
-  std::map<std::string, std::vector<SE3>> answers, reversed;
+  std::map<std::string, std::vector<SE3>> answers, reversed, midpoints;
   for (const std::string& scene : scenes) {
     const auto devices = device_clouds(scene);
     mlidar::Scan top = scan_of(devices.at(0));
@@ -177,6 +178,8 @@ int main(int argc, char** argv) {
         std::printf(" | reverse: %s, base-frame rotation (%.3f %.3f %.3f) deg, %.4f m from it", std::string(to_string(b.verdict)).c_str(),
                     d.x(), d.y(), d.z(), (T.translation() - t).norm());
         reversed[side].push_back(T);
+        const Vec3 half = 0.5 * mlidar::so3_log(T.rotation() * r.T_ref_target.rotation().inverse());
+        midpoints[side].push_back(SE3(mlidar::so3_exp(half) * r.T_ref_target.rotation(), 0.5 * (T.translation() + t)));
       }
       if (options.perturbed) {
         const auto p = mlidar::calib::refine_pair(top.points, target.points, guess(data_dir() / "perturbed_init" / (scene + ".txt"), id),
@@ -196,6 +199,8 @@ int main(int argc, char** argv) {
   if (options.reverse) {
     print_spread("left rev", reversed["left"]);
     print_spread("right rev", reversed["right"]);
+    print_spread("left mid", midpoints["left"]);
+    print_spread("right mid", midpoints["right"]);
   }
   return 0;
 }

@@ -93,6 +93,7 @@ nlohmann::json report_json(const calib::PairRefineResult& r, double overlap_radi
           {"reasons", r.reasons},
           {"searched", r.searched},
           {"chosen_start", r.chosen_start},
+          {"symmetric", r.symmetric},
           {"starts", starts},
           {"T_ref_target_initial", pose_json(r.T_init)},
           {"T_ref_target", pose_json(r.T_ref_target)},

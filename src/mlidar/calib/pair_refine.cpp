@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -149,6 +150,19 @@ std::vector<Candidate> search(RefSurface& surface, std::span<const Eigen::Vector
   return finalists;
 }
 
+/// Midpoint of T_forward and the inverse of the reverse registration on SO(3) x R^3
+/// (half the geodesic from one rotation to the other; mean translation), or nullopt
+/// when the reverse registration did not settle or is a distinct pose.
+std::optional<SE3> symmetric_answer(std::span<const Eigen::Vector3f> ref, std::span<const Eigen::Vector3f> target,
+                                    const SE3& T_forward, const PairRefineConfig& config) {
+  RefSurface target_surface(std::vector<Eigen::Vector3f>(target.begin(), target.end()), config.surface);
+  const IcpResult back = point_to_plane_icp(target_surface, ref, T_forward.inverse(), config.icp);
+  const SE3 T_backward = back.T_ref_source.inverse();
+  if (!back.converged || !back.enough_matches || distinct(T_forward, T_backward, config)) return std::nullopt;
+  const Vec3 half = 0.5 * so3_log(T_backward.rotation() * T_forward.rotation().inverse());
+  return SE3(so3_exp(half) * T_forward.rotation(), 0.5 * (T_forward.translation() + T_backward.translation()));
+}
+
 }  // namespace
 
 std::string_view to_string(PairVerdict verdict) {
@@ -191,8 +205,14 @@ PairRefineResult refine_pair(std::span<const Eigen::Vector3f> ref, std::span<con
   std::stable_sort(candidates.begin(), candidates.end(), better);
   const Candidate& best = candidates.front();
 
-  // 3. The answer, its uncertainty and overlap (eq 3.13-3.14), and the verdict.
+  // 3. The answer (symmetric: the midpoint of both directions), its uncertainty and overlap (eq 3.13-3.14), and the verdict.
   result.T_ref_target = best.icp.T_ref_source;
+  if (config.symmetric) {
+    if (const std::optional<SE3> T = symmetric_answer(ref_thin, target_thin, result.T_ref_target, config)) {
+      result.T_ref_target = *T;
+      result.symmetric = true;
+    }
+  }
   result.chosen_start = best.label;
   result.information = best.icp.information;
   result.covariance_icp = additive_translation_covariance(best.icp.covariance, result.T_ref_target.translation());
