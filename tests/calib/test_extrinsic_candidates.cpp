@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "mlidar/calib/extrinsic_candidates.hpp"
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/so3.hpp"
 
 namespace mlidar::calib {
@@ -92,7 +93,12 @@ TEST(AverageBestCandidates, KeepsLowErrorCandidatesAndRecoversTruth) {
   EXPECT_NEAR(std::sqrt(average.covariance_spread(0, 0)), 0.005, 0.002);
   EXPECT_NEAR(std::sqrt(average.covariance_spread(3, 3)), 1e-3, 4e-4);
   EXPECT_NEAR(average.covariance_icp(0, 0), 1.0 / (20.0 * 1e6), 1e-12);
-  EXPECT_TRUE(average.covariance.isApprox(average.covariance_spread + average.covariance_icp));
+  // The shared-bias term: the selection's per-axis sds on the diagonal, added to the rest.
+  const CandidateSelection defaults;
+  EXPECT_DOUBLE_EQ(std::sqrt(average.covariance_bias(2, 2)), defaults.bias_translation_sd_m);
+  EXPECT_NEAR(std::sqrt(average.covariance_bias(4, 4)), deg_to_rad(defaults.bias_rotation_sd_deg), 1e-15);
+  EXPECT_TRUE(average.covariance_bias.isDiagonal());
+  EXPECT_TRUE(average.covariance.isApprox(average.covariance_spread + average.covariance_icp + average.covariance_bias));
 
   // The input order does not matter.
   std::vector<ExtrinsicCandidate> shuffled = candidates;

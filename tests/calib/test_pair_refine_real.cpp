@@ -2,8 +2,10 @@
 // left, right; the rig did not change between scenes). No answer key exists,
 // so the property is consistency (issue 8): refined from initial_extrinsic.txt
 // every scene converges and the three answers for left and for right agree
-// within 0.3 deg and 5 cm. From the much worse perturbed_init guesses the
-// refinement reaches the same answer or says it did not converge.
+// within 0.3 deg and 5 cm, and their differences are consistent with the
+// reported covariances. From the much worse perturbed_init guesses the
+// refinement reaches the same answer or says it did not converge (one scene
+// per side here; every scene: bench/pair_refine_scenes perturbed=1).
 #include <algorithm>
 #include <array>
 #include <fstream>
@@ -25,8 +27,9 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double kAgreeDeg = 0.3;  // perturbed guess vs initial guess, same scene
-constexpr double kScenesDeg = 0.5;  // across scenes (see ThreeScenesAgree)
+constexpr double kScenesDeg = 0.3;  // across scenes: the issue's criterion (see ThreeScenesAgree)
 constexpr double kAgreeM = 0.05;
+constexpr double kChi2Six99 = 16.81;  // chi-square, 6 dof, 0.99 quantile
 const std::array<std::string, 3> kScenes{"0001", "0002", "0003"};
 
 fs::path scene_dir(const std::string& scene) { return shared_data() / "real" / "opencalib_3lidar" / scene; }
@@ -131,12 +134,17 @@ Spread max_pairwise(const std::vector<SE3>& poses) {
 
 class RealPairRefine : public ::testing::TestWithParam<std::string> {};
 
-// Issue 8's criterion is 0.3 deg / 5 cm. Measured (Release): right 0.25 deg /
-// 4.7 cm (met), left 0.44 deg / 2.9 cm (NOT met: scene 0001 sits ~0.3 deg from
-// the other two while each result's own 1-sigma is ~0.02 deg, so the single
-// frames differ more than the covariance says; the clouds are stamped up to
-// 35 ms apart on a car that may move). This bound, 0.5 deg / 5 cm, guards
-// against regressions; docs/benchmarks.md has the table.
+// Issue 8's criterion is 0.3 deg / 5 cm. Measured (Release, symmetric answer):
+// left 0.285 deg / 3.1 cm, right 0.279 deg / 3.1 cm: met, with a thin margin
+// (target->reference alone gave left 0.44 deg; docs/benchmarks.md has the
+// diagnostics). The difference of two scenes' answers must fit
+// their summed covariance (NEES below the chi-square 99% bound): the reported
+// covariance carries the per-scene systematic term, the ICP's alone does not.
+Vec6 difference(const SE3& a, const SE3& b) {
+  Vec6 d;
+  d << a.translation() - b.translation(), so3_log(a.rotation() * b.rotation().inverse());
+  return d;
+}
 TEST_P(RealPairRefine, ThreeScenesAgree) {
   MLIDAR_REQUIRE_SHARED_DATA();
   const std::string side = GetParam();
@@ -146,6 +154,17 @@ TEST_P(RealPairRefine, ThreeScenesAgree) {
     EXPECT_NE(r.verdict, calib::PairVerdict::kNotConverged) << scene << ' ' << side;
     answers.push_back(r.T_ref_target);
   }
+  for (std::size_t i = 0; i < kScenes.size(); ++i)
+    for (std::size_t j = i + 1; j < kScenes.size(); ++j) {
+      const calib::PairRefineResult& a = initial_answer(kScenes[i], side);
+      const calib::PairRefineResult& b = initial_answer(kScenes[j], side);
+      const Vec6 d = difference(a.T_ref_target, b.T_ref_target);
+      const double nees = d.dot((a.covariance + b.covariance).ldlt().solve(d));
+      const double nees_icp = d.dot((a.covariance_icp + b.covariance_icp).ldlt().solve(d));
+      std::cout << side << ' ' << kScenes[i] << '-' << kScenes[j] << " NEES of the difference " << nees
+                << " (ICP covariance alone " << nees_icp << ")\n";
+      EXPECT_LT(nees, kChi2Six99) << side << ' ' << kScenes[i] << '-' << kScenes[j];
+    }
   const Spread spread = max_pairwise(answers);
   std::cout << side << " max pairwise difference " << spread.deg << " deg, " << spread.m << " m\n";
   EXPECT_LT(spread.deg, kScenesDeg);
@@ -155,7 +174,10 @@ TEST_P(RealPairRefine, ThreeScenesAgree) {
 TEST_P(RealPairRefine, PerturbedGuessesReachTheSameAnswerOrSayNot) {
   MLIDAR_REQUIRE_SHARED_DATA();
   const std::string side = GetParam();
-  for (const std::string& scene : kScenes) {
+  // One scene per side keeps the test short: the worst guess of each side (left
+  // 0002: roll -63 deg; right 0001: roll 54, yaw 37 deg off). Every scene and
+  // side: bench/pair_refine_scenes perturbed=1.
+  for (const std::string& scene : {side == "left" ? std::string("0002") : std::string("0001")}) {
     const fs::path perturbed = shared_data() / "real" / "opencalib_3lidar" / "perturbed_init" / (scene + ".txt");
     const calib::PairRefineResult r = refine(scene, side, perturbed);
     print(scene, side, "perturbed", r);

@@ -1,12 +1,14 @@
 #include "mlidar/calib/extrinsic_candidates.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/rotation_average.hpp"
 #include "mlidar/geometry/kdtree.hpp"
 
@@ -107,7 +109,11 @@ CandidateAverage average_best_candidates(std::span<const ExtrinsicCandidate> can
   // and odometry errors, so their mean is not n times better than one of them.
   if (keep > 1) out.covariance_spread = scatter / (static_cast<double>(keep) - 1.0);
   out.covariance_icp = inverse_psd(information);
-  out.covariance = out.covariance_spread + out.covariance_icp;
+  Vec6 bias_variance;
+  bias_variance << Vec3::Constant(selection.bias_translation_sd_m * selection.bias_translation_sd_m),
+      Vec3::Constant(std::pow(deg_to_rad(selection.bias_rotation_sd_deg), 2));
+  out.covariance_bias = bias_variance.asDiagonal();
+  out.covariance = out.covariance_spread + out.covariance_icp + out.covariance_bias;
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -47,6 +48,15 @@ Mat6 additive_translation_covariance(const Mat6& left, const Vec3& t) {
   M.topRightCorner<3, 3>() = -hat(t);
   const Mat6 covariance = M * left * M.transpose();
   return 0.5 * (covariance + covariance.transpose());  // exactly symmetric for the YAML writer/reader
+}
+
+/// Diagonal per-scene systematic term of the reported covariance (config, 1-sigma per axis).
+Mat6 systematic_covariance(const PairRefineConfig& config) {
+  const double rotation_var = std::pow(deg_to_rad(config.systematic_rotation_sd_deg), 2);
+  const double translation_var = std::pow(config.systematic_translation_sd_m, 2);
+  Vec6 diagonal;
+  diagonal << Vec3::Constant(translation_var), Vec3::Constant(rotation_var);
+  return diagonal.asDiagonal();
 }
 
 double largest_sd(const Mat3& block) {
@@ -107,6 +117,8 @@ std::vector<Eigen::Vector3f> beyond(std::span<const Eigen::Vector3f> points, dou
 void check_config(const PairRefineConfig& config) {
   if (!(config.min_range >= 0.0) || !(config.ref_voxel_size > 0.0) || !(config.search_ref_voxel_size > 0.0) || !(config.overlap_radius > 0.0) || !(config.fitness_voxel_size > 0.0))
     throw std::invalid_argument("refine_pair: voxel sizes and overlap_radius must be > 0");
+  if (!(config.systematic_rotation_sd_deg >= 0.0) || !(config.systematic_translation_sd_m >= 0.0))
+    throw std::invalid_argument("refine_pair: systematic sd must be >= 0");
   if (config.search_finalists == 0) throw std::invalid_argument("refine_pair: search_finalists must be >= 1");
 }
 
@@ -136,6 +148,19 @@ std::vector<Candidate> search(RefSurface& surface, std::span<const Eigen::Vector
     finalists.push_back(std::move(c));
   }
   return finalists;
+}
+
+/// Midpoint of T_forward and the inverse of the reverse registration on SO(3) x R^3
+/// (half the geodesic from one rotation to the other; mean translation), or nullopt
+/// when the reverse registration did not settle or is a distinct pose.
+std::optional<SE3> symmetric_answer(std::span<const Eigen::Vector3f> ref, std::span<const Eigen::Vector3f> target,
+                                    const SE3& T_forward, const PairRefineConfig& config) {
+  RefSurface target_surface(std::vector<Eigen::Vector3f>(target.begin(), target.end()), config.surface);
+  const IcpResult back = point_to_plane_icp(target_surface, ref, T_forward.inverse(), config.icp);
+  const SE3 T_backward = back.T_ref_source.inverse();
+  if (!back.converged || !back.enough_matches || distinct(T_forward, T_backward, config)) return std::nullopt;
+  const Vec3 half = 0.5 * so3_log(T_backward.rotation() * T_forward.rotation().inverse());
+  return SE3(so3_exp(half) * T_forward.rotation(), 0.5 * (T_forward.translation() + T_backward.translation()));
 }
 
 }  // namespace
@@ -180,11 +205,18 @@ PairRefineResult refine_pair(std::span<const Eigen::Vector3f> ref, std::span<con
   std::stable_sort(candidates.begin(), candidates.end(), better);
   const Candidate& best = candidates.front();
 
-  // 3. The answer, its uncertainty and overlap (eq 3.13-3.14), and the verdict.
+  // 3. The answer (symmetric: the midpoint of both directions), its uncertainty and overlap (eq 3.13-3.14), and the verdict.
   result.T_ref_target = best.icp.T_ref_source;
+  if (config.symmetric) {
+    if (const std::optional<SE3> T = symmetric_answer(ref_thin, target_thin, result.T_ref_target, config)) {
+      result.T_ref_target = *T;
+      result.symmetric = true;
+    }
+  }
   result.chosen_start = best.label;
   result.information = best.icp.information;
-  result.covariance = additive_translation_covariance(best.icp.covariance, result.T_ref_target.translation());
+  result.covariance_icp = additive_translation_covariance(best.icp.covariance, result.T_ref_target.translation());
+  result.covariance = result.covariance_icp + systematic_covariance(config);
   result.rotation_sd_deg = rad_to_deg(largest_sd(result.covariance.bottomRightCorner<3, 3>()));
   result.translation_sd_m = largest_sd(result.covariance.topLeftCorner<3, 3>());
   result.rmse = best.icp.rmse;

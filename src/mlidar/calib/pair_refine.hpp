@@ -3,7 +3,8 @@
 // thesis 3.4.3): robust point-to-plane ICP of the target scan against the
 // reference scan from the guess; when that registration is poor (or when
 // asked) a multi-start search from ground-plane-aligned starts with a yaw
-// sweep (coarse_search.hpp) looks for a better basin. The verdict says
+// sweep (coarse_search.hpp) looks for a better basin; the answer is then
+// averaged with the reverse registration (reference onto target). The verdict says
 // whether the answer can be trusted and whether it took a search; the reasons
 // say why not. Never a silently wrong answer: a result that fails a check is
 // reported as not converged.
@@ -44,6 +45,17 @@ struct PairRefineConfig {
   double ambiguity_margin = 0.03;       ///< a different pose this close in overlap makes the answer ambiguous
   double distinct_rotation_deg = 2.0;   ///< poses farther apart than this (or distinct_translation_m) are different
   double distinct_translation_m = 0.2;
+  /// Also register the reference to the target from the answer and return the
+  /// midpoint of the two (each direction's point-to-plane bias, from whose
+  /// normals are used, enters with opposite sign); skipped when that reverse
+  /// registration does not settle or lands a distinct pose away.
+  bool symmetric = true;
+  // Per-scene systematic error added to the reported covariance (1-sigma per axis): what one
+  // pair of single scans cannot see from its own residuals (capture-time offsets between the
+  // LiDARs, motion during the sweep, surface sampling). Default: the pooled per-axis scatter of
+  // the three opencalib_3lidar scenes, left and right (docs/benchmarks.md, "Pairwise refinement").
+  double systematic_rotation_sd_deg = 0.09;
+  double systematic_translation_sd_m = 0.01;
 };
 
 /// One start of the search, after its short ICP.
@@ -61,7 +73,8 @@ struct PairRefineResult {
   SE3 T_init;
   SE3 T_ref_target;
   Mat6 information = Mat6::Zero();    ///< J^T W J of the final ICP, left perturbation [rho, phi]
-  Mat6 covariance = Mat6::Zero();     ///< [t, r]: t additive, r as a left perturbation Exp(d) R
+  Mat6 covariance = Mat6::Zero();     ///< [t, r]: t additive, r as a left perturbation Exp(d) R; covariance_icp + systematic term
+  Mat6 covariance_icp = Mat6::Zero(); ///< same frame, the ICP's s^2 H^-1 alone (points independent: over-confident)
   double rotation_sd_deg = 0.0;       ///< sqrt of the largest eigenvalue of the rotation block
   double translation_sd_m = 0.0;      ///< same for the translation block
   double rmse = 0.0;                  ///< m
@@ -69,6 +82,7 @@ struct PairRefineResult {
   Overlap overlap;                    ///< eq 3.13-3.14 at the answer, radius overlap_radius
   int iterations = 0;
   bool searched = false;              ///< the multi-start search ran
+  bool symmetric = false;             ///< the answer is the midpoint of both directions (PairRefineConfig::symmetric)
   std::string chosen_start = "init";  ///< "init" or the label of the winning start
   std::vector<SearchStart> starts;    ///< every start tried, in order
 };

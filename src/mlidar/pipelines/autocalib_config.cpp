@@ -33,7 +33,8 @@ void read_handeye(const io::YamlFields& fields, const YAML::Node& map, calib::Ha
 void read_refine(const io::YamlFields& fields, const YAML::Node& map, RefineConfig& config) {
   fields.only_keys(map, "refine",
                    {"frame_step", "window", "overlap_radius_m", "min_overlap", "relative_overlap", "coarse_correspondence_m",
-                    "fine_correspondence_m", "min_match_ratio", "min_candidates", "keep_fraction", "min_keep"});
+                    "fine_correspondence_m", "min_match_ratio", "min_candidates", "keep_fraction", "min_keep",
+                    "bias_translation_sd_m", "bias_rotation_sd_deg"});
   const std::string p = "refine.";
   read_integer(fields, map, p, "frame_step", 1, 100000, config.frame_step);
   read_integer(fields, map, p, "window", 0, 1000, config.window);
@@ -46,6 +47,8 @@ void read_refine(const io::YamlFields& fields, const YAML::Node& map, RefineConf
   read_integer(fields, map, p, "min_candidates", std::size_t{1}, std::size_t{100000}, config.min_candidates);
   read_number(fields, map, p, "keep_fraction", 1e-3, 1.0, config.selection.keep_fraction);
   read_integer(fields, map, p, "min_keep", std::size_t{1}, std::size_t{100000}, config.selection.min_keep);
+  read_number(fields, map, p, "bias_translation_sd_m", 0.0, 10.0, config.selection.bias_translation_sd_m);
+  read_number(fields, map, p, "bias_rotation_sd_deg", 0.0, 90.0, config.selection.bias_rotation_sd_deg);
 }
 
 }  // namespace

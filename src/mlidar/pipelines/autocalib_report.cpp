@@ -54,6 +54,7 @@ nlohmann::json refine_json(const LidarCalibration& c) {
     j["covariance"] = matrix_json(r.average.covariance);
     j["covariance_spread"] = matrix_json(r.average.covariance_spread);
     j["covariance_icp"] = matrix_json(r.average.covariance_icp);
+    j["covariance_bias"] = matrix_json(r.average.covariance_bias);
   }
   return j;
 }
