@@ -20,6 +20,7 @@
 #include <fstream>
 #include <map>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -134,7 +135,10 @@ void print_spread(const char* label, const std::vector<SE3>& poses) {
 }
 
 SE3 guess(const fs::path& file, int device) {
-  return mlidar::io::read_opencalib_initial_extrinsics(file).find("device_" + std::to_string(device))->T_base_lidar;
+  const mlidar::io::Extrinsics initial = mlidar::io::read_opencalib_initial_extrinsics(file);
+  const auto* lidar = initial.find("device_" + std::to_string(device));
+  if (lidar == nullptr) throw std::runtime_error(file.string() + ": no device_" + std::to_string(device));
+  return lidar->T_base_lidar;
 }
 
 }  // namespace
