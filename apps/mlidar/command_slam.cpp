@@ -14,14 +14,23 @@ namespace {
 void print_lidar(const pipelines::SlamLidarReport& lidar) {
   std::cout << "  " << lidar.name << ": " << pipelines::to_string(lidar.role);
   if (lidar.initialized_frame) std::cout << ", initialized at frame " << *lidar.initialized_frame;
-  if (lidar.initialization.planar_motion) std::cout << " (planar motion: translation along the rotation axis fixed to 0)";
+  if (lidar.initialization.planar_motion) std::cout << " (planar motion)";
   const auto& sv = lidar.initialization.singular_values;
   if (lidar.role == pipelines::LidarRole::initializing && lidar.initialization.pairs_stored >= 10 && sv[2] < 0.1 * sv[1])
     std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
+  if (lidar.translation_start == "zero") std::cout << " (translation not solvable from motion: started from 0)";
   if (lidar.converged_frame) std::cout << ", converged at frame " << *lidar.converged_frame;
   if (lidar.restarts > 0) std::cout << ", " << lidar.restarts << " re-calibration(s) after an extrinsic shock";
   if (lidar.missing_frames > 0) std::cout << ", " << lidar.missing_frames << " frame(s) without a scan";
   std::cout << '\n';
+  if (lidar.restarts == 0 && !lidar.reinitialization_frames.empty())
+    std::cout << "    re-initialized " << lidar.reinitialization_frames.size() << " time(s): its window residuals stayed high against the map\n";
+  for (const auto& direction : lidar.unobservable_from_motion) {
+    const bool observed = lidar.converged_frame.has_value() || lidar.accepted > 0;
+    std::cout << "    unobservable from motion: " << direction << "; "
+              << (observed ? "observed by the calibration window (accepted against the map)" : "not yet observed by the calibration window") << '\n';
+  }
+  if (!lidar.axis_translation_source.empty()) std::cout << "    translation along the axis at the start: " << lidar.axis_translation_source << '\n';
   for (const auto& weak : lidar.weak) std::cout << "    weakly observed: " << weak.description << " (information " << weak.eigenvalue << ")\n";
 }
 

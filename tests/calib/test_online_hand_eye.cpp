@@ -205,4 +205,67 @@ TEST(OnlineHandEye, ResidualAngleIsZeroForExactPairsAndTheMisalignmentOtherwise)
 }
 
 }  // namespace
+TEST(OnlineHandEye, PairsWithInvalidTranslationGiveRotationOnly) {
+  // Every pair's rotations are exact; most translations of B are wrong by
+  // decimetres (a LiDAR's odometry sliding in a degenerate scene). Flagged as
+  // translation-invalid, they still fix the rotation, and t comes from the rest.
+  std::mt19937_64 rng(21);
+  OnlineHandEye flagged;
+  OnlineHandEye unflagged;
+  int k = 0;
+  for (MotionPair p : general_pairs(60, 22)) {
+    const bool valid = k++ % 4 == 0;
+    if (!valid) p.B = SE3(p.B.rotation(), p.B.translation() + gaussian3(rng, 0.3));
+    flagged.add(p, valid);
+    unflagged.add(p);
+  }
+  ASSERT_EQ(flagged.status().state, OnlineHandEyeState::ready);
+  EXPECT_EQ(flagged.status().pairs_translation, 15u);
+  EXPECT_LE(rotation_error(flagged.status().T_base_lidar, kTruth), 1e-9);
+  EXPECT_LE((flagged.status().T_base_lidar.translation() - kTruth.translation()).norm(), 1e-9);
+  EXPECT_LT(flagged.status().translation_std_m, 1e-6);
+  // The same pairs all used: the translation is off and its predicted std says so.
+  EXPECT_GT((unflagged.status().T_base_lidar.translation() - kTruth.translation()).norm(), 0.01);
+  EXPECT_GT(unflagged.status().translation_std_m, 0.01);
+}
+
+TEST(OnlineHandEye, TranslationStdGateHoldsBackAPoorTranslation) {
+  std::mt19937_64 rng(23);
+  std::vector<MotionPair> noisy;
+  for (const MotionPair& p : general_pairs(30, 24)) noisy.push_back(perturb(p, rng, 1e-4, 0.1));
+  OnlineHandEyeConfig strict;
+  strict.translation_max_std_m = 0.01;
+  const OnlineHandEye gated = fed(noisy, strict);
+  EXPECT_EQ(gated.status().state, OnlineHandEyeState::rotation_ready);
+  EXPECT_GT(gated.status().translation_std_m, 0.01);
+  OnlineHandEyeConfig loose;
+  loose.translation_max_std_m = 10.0;
+  EXPECT_EQ(fed(noisy, loose).status().state, OnlineHandEyeState::ready);
+}
+
+TEST(OnlineHandEye, PlanarRotationStartsFromTranslationsWithTheAxisFlagged) {
+  // A ground robot turning about the base's z only (eq 4.17's test cannot
+  // pass): with planar_rotation the start is eq 3.8-3.12, exact on exact pairs
+  // except t along z, which is 0 and flagged.
+  std::mt19937_64 rng(25);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<MotionPair> pairs;
+  for (int k = 0; k < 60; ++k) pairs.push_back(exact_pair(Vec3(0.0, 0.0, 0.3 * n(rng)), Vec3(1.0 + n(rng), n(rng), 0.0)));
+  EXPECT_EQ(fed(pairs).status().state, OnlineHandEyeState::collecting);  // off by default
+  OnlineHandEyeConfig planar;
+  planar.planar_rotation = true;
+  const OnlineHandEyeStatus s = fed(pairs, planar).status();
+  ASSERT_EQ(s.state, OnlineHandEyeState::ready);
+  EXPECT_TRUE(s.planar_motion);
+  EXPECT_TRUE(s.planar_rotation);
+  EXPECT_GT(s.unobservable_axis_base.z(), 0.999);
+  EXPECT_LE(rotation_error(s.T_base_lidar, kTruth), 1e-6);
+  EXPECT_NEAR(s.T_base_lidar.translation().z(), 0.0, 1e-9);
+  EXPECT_LE((s.T_base_lidar.translation().head<2>() - kTruth.translation().head<2>()).norm(), 1e-6);
+  // Pure yaw without translation leaves the rotation about z unobservable: no start.
+  std::vector<MotionPair> spinning;
+  for (int k = 0; k < 60; ++k) spinning.push_back(exact_pair(Vec3(0.0, 0.0, 0.3 * n(rng)), Vec3::Zero()));
+  EXPECT_NE(fed(spinning, planar).status().state, OnlineHandEyeState::ready);
+}
+
 }  // namespace mlidar::calib

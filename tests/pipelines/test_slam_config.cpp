@@ -37,7 +37,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 23u);
+  EXPECT_EQ(slam_config_keys().size(), 30u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -101,6 +101,12 @@ TEST(SlamConfig, RejectsWithFileKeyAndRange) {
       {"initialization:\n  translation_min_ratio: 0.06\n", "initialization.translation_min_ratio",
        "(0, initialization.planar_ratio = 0.05)"},
       {"initialization:\n  max_constraints: -1\n", "initialization.max_constraints", "an integer in [2, 100000]"},
+      {"initialization:\n  translation_max_std_m: 0\n", "initialization.translation_max_std_m", "a number in (0, 1e+09]"},
+      {"initialization:\n  planar_rotation: 2\n", "initialization.planar_rotation", "true or false, got '2'"},
+      {"initialization:\n  reinitialize_after_windows: 1.5\n", "initialization.reinitialize_after_windows",
+       "an integer in [0, 100000]"},
+      {"initialization:\n  zero_translation_after_pairs: -1\n", "initialization.zero_translation_after_pairs",
+       "an integer in [0, 100000]"},
       {"convergence:\n  lambda_calib: -70\n", "convergence.lambda_calib", "a number in (0, 1e+09]"},
       {"convergence:\n  accepted_needed: 1\n", "convergence.accepted_needed", "an integer in [2, 100000]"},
       {"shock:\n  relative_to_others: maybe\n", "shock.relative_to_others", "true or false, got 'maybe'"},

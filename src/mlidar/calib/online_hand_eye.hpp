@@ -9,7 +9,11 @@
 // singular value exceeds sigma_R (eq 4.17's test). Translation: eq 4.18 by
 // least squares; when the base's rotation axes are (nearly) all parallel
 // (planar motion) the translation along that axis is unobservable and is
-// fixed to 0 (t_z = 0 for a ground robot) with planar_motion set.
+// fixed to 0 (t_z = 0 for a ground robot) with planar_motion set. A pair may
+// be given for its rotation only (its translations inconsistent, eq 3.4's
+// pitch); the translation is ready only from translation_min_pairs such pairs
+// and a predicted standard deviation below translation_max_std_m. With
+// planar_rotation, rotations about one common axis start from eq 3.8-3.12.
 // The state is recomputed from the stored pairs on every add.
 #include <array>
 #include <cstddef>
@@ -30,6 +34,21 @@ struct OnlineHandEyeConfig {
   double planar_ratio = 0.05;
   /// Translation solvable when the second-smallest / largest eigenvalue of eq 4.18's normal matrix exceeds this.
   double translation_min_ratio = 1e-3;
+  /// Ready only when eq 4.18's predicted standard deviation of t (residual
+  /// variance times the largest eigenvalue of the inverse normal matrix, over
+  /// the solved directions) is below this (m): a start from few pairs with
+  /// small rotations was 1.5 m off (campus seed 7) where the calibration
+  /// window's gates (1.0 / 0.3 m) cannot pull it in.
+  double translation_max_std_m = 1e9;
+  /// Fewer translation-valid pairs: the translation is not solved (one pair's
+  /// rows have rank 2 and would read as planar motion about its own axis).
+  std::size_t translation_min_pairs = 3;
+  /// Planar motion of the rotations (sigma_min2 <= sigma_R < second-largest
+  /// singular value: one common axis): rotation up to the rotation about the
+  /// axis from eq 3.8-3.9, the rotation about it and x, y from the
+  /// translations (eq 3.10-3.12), t along the axis 0 and flagged; off: stay collecting.
+  bool planar_rotation = false;
+  double planar_min_condition = 1e-3;  ///< eq 3.12 system's s_min / s_max below this: yaw or x, y unobservable
 };
 
 enum class OnlineHandEyeState { collecting, rotation_ready, ready };
@@ -53,6 +72,9 @@ struct OnlineHandEyeStatus {
   Vec3 unobservable_axis_base = Vec3::Zero();  ///< unit, set when planar_motion
   std::array<double, 3> translation_eigenvalues{};  ///< of eq 4.18's normal matrix, ascending
   double rotation_rms_rad = 0.0;   ///< rms residual angle (eq 4.17's phi) over the stored pairs
+  std::size_t pairs_translation = 0;  ///< stored pairs whose translation is used (eq 4.18)
+  double translation_std_m = -1.0;    ///< eq 4.18's predicted standard deviation (-1: not solved)
+  bool planar_rotation = false;       ///< rotation about unobservable_axis_base from the translations (eq 3.10-3.12)
 };
 
 class OnlineHandEye {
@@ -61,8 +83,10 @@ class OnlineHandEye {
   explicit OnlineHandEye(OnlineHandEyeConfig config = {});
 
   /// Adds one motion pair (eq 4.15 rows), re-weights the stored rows from the
-  /// current estimate (eq 4.17) and re-solves.
-  PairOutcome add(const MotionPair& pair);
+  /// current estimate (eq 4.17) and re-solves. `translation_valid` false: the
+  /// pair's rotations are used, its translations not (eq 4.18 skips it; e.g.
+  /// its screw pitches disagree, eq 3.4, while its angles agree).
+  PairOutcome add(const MotionPair& pair, bool translation_valid = true);
   const OnlineHandEyeStatus& status() const { return status_; }
   std::span<const MotionPair> pairs() const { return pairs_; }
   /// Forgets every pair (e.g. after an extrinsic shock).
@@ -70,10 +94,13 @@ class OnlineHandEye {
 
  private:
   void solve();
+  void solve_translation(std::span<const double> weights, const Quat& R_base_lidar);
+  void solve_planar_rotation();
 
   OnlineHandEyeConfig config_;
   std::vector<MotionPair> pairs_;
   std::vector<double> rotation_angles_;  ///< min(angle(A), angle(B)) of each stored pair
+  std::vector<bool> translation_valid_;  ///< per stored pair
   OnlineHandEyeStatus status_;
 };
 

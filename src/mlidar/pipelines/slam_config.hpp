@@ -27,8 +27,19 @@ struct WindowParams {
   bool refine_odometry = false;
 };
 
+/// How a LiDAR's calibration starts and starts again (beyond the thesis).
+struct StartParams {
+  std::size_t reinitialize_windows = 10;     ///< windows not accepted with a high residual ratio since the last acceptance (0: never)
+  double reinitialize_residual_ratio = 2.0;  ///< high: the window's residual against the map above this times the base's own
+  /// Pairs added with the rotation ready but not the translation before the
+  /// window starts from the rotation and t = 0 (0: never).
+  std::size_t zero_translation_after_pairs = 20;
+};
+
 struct SlamConfig {
-  calib::OnlineHandEyeConfig initialization;  ///< eq 4.15-4.18
+  /// Eq 4.15-4.18; measured defaults beyond the thesis: the translation's predicted std gate and the planar start.
+  calib::OnlineHandEyeConfig initialization{.translation_max_std_m = 0.1, .planar_rotation = true};
+  StartParams start;
   calib::ConvergenceConfig convergence;       ///< Algorithm 1
   WindowParams window;
   calib::ShockDetectorConfig shock;           ///< re-calibration trigger

@@ -3,12 +3,12 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <utility>
 
 #include "mlidar/calib/ground_up.hpp"
+#include "mlidar/pipelines/slam_track.hpp"
 #include "mlidar/slam/calibration_window.hpp"
 
 namespace mlidar::pipelines {
@@ -21,12 +21,6 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 /// hand-eye start may be a degree and centimetres off (0.5 m at 30 m range),
 /// the second pass matches at the first pass's solution.
 constexpr std::array<double, 2> kCalibrationGatesM = {1.0, 0.3};
-/// Frames between the two ends of a motion pair (eq 4.13 pairs consecutive
-/// frames). Measured on the simulated rhd handheld drive (80 frames, 10 Hz):
-/// with consecutive frames sigma_min2 of Q_K reached only 0.13 < sigma_R =
-/// 0.25 (rotations of 1-3 deg per frame); pairs 5 frames apart (overlapping,
-/// one per frame) rotate 5x more.
-constexpr std::size_t kPairStride = 5;
 /// Mean residual gate (m) of the shock score: a shifted LiDAR's features must still match.
 constexpr double kShockGateM = 1.0;
 
@@ -44,11 +38,6 @@ Frame trusted_frame(double stamp, const std::vector<std::optional<Scan>>& scans,
 calib::ConvergenceConfig with_window_overlap(calib::ConvergenceConfig config, int window_size) {
   config.min_autocorrelation_time = window_size + 1.0;
   return config;
-}
-
-slam::LidarSetup with_extrinsic(slam::LidarSetup setup, const SE3& T_base_lidar) {
-  setup.T_base_lidar = T_base_lidar;
-  return setup;
 }
 
 /// Base-frame features at the stamp, brought back into the LiDAR's frame.
@@ -72,37 +61,6 @@ std::string_view to_string(LidarRole role) {
   }
   return "unknown";
 }
-
-/// One LiDAR's state across frames.
-struct SlamEstimator::Track {
-  slam::LidarSetup setup;  ///< T_base_lidar: the current extrinsic
-  LidarRole role = LidarRole::initializing;
-  calib::OnlineHandEye hand_eye;
-  std::unique_ptr<slam::Odometry> own;      ///< its own odometry while initializing
-  /// T_g_lidar: the frame g the own odometry runs in is the LiDAR's rotated by
-  /// the given extrinsic's rotation (identity when none is given), so that its
-  /// ground segmentation knows which way is up (with identity, a LiDAR rolled
-  /// 40 deg lost every frame on 2 of 10 seeds); B_k is taken back to the LiDAR
-  /// frame, so the hand-eye does not depend on it.
-  SE3 T_g_lidar;
-  struct PosePair {
-    SE3 T_world_lidar;  ///< own odometry
-    SE3 T_world_base;   ///< trusted odometry, same frame
-  };
-  std::deque<PosePair> recent;              ///< the last kPairStride + 1 frames, without gaps
-  std::vector<slam::CalibrationFrame> window;  ///< the last N + 1 frames while calibrating
-  struct Pending {
-    Scan scan;
-    double stamp = 0.0;
-    SE3 T_world_base;
-  };
-  std::optional<Pending> pending;  ///< while calibrating: the last scan, deskewed at the next frame
-  slam::FrontEndWorkspace workspace;
-  slam::LidarFeatures features;
-  SlamLidarReport report;
-
-  Track(slam::LidarSetup lidar, calib::OnlineHandEyeConfig config) : setup(std::move(lidar)), hand_eye(config) {}
-};
 
 SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source)
     : config_(std::move(config)),
@@ -145,34 +103,6 @@ void SlamEstimator::run_trusted_odometry(double stamp, const std::vector<std::op
   out.T_world_base = last_odometry_.T_world_base;
 }
 
-void SlamEstimator::initialize(std::size_t j, double stamp, const Scan& scan, std::size_t frame_index, SlamLidarFrame& out) {
-  Track& track = *tracks_[j];
-  const slam::FrameResult own = track.own->process(Frame{stamp, {scan}});
-  const SE3 T_world_lidar = own.T_world_base * track.T_g_lidar;
-  const SE3& T_world_base = last_odometry_.T_world_base;
-  if (own.lost || last_odometry_.lost) {
-    track.recent.clear();  // no motion pair across a frame that did not register
-    return;
-  }
-  track.recent.push_back({T_world_lidar, T_world_base});
-  if (track.recent.size() > kPairStride) {
-    // Eq 4.13 over kPairStride frames: A = T_{b_{k-s} b_k}, B = T_{l_{k-s} l_k}.
-    const auto& from = track.recent.front();
-    const calib::MotionPair pair{from.T_world_base.inverse() * T_world_base, from.T_world_lidar.inverse() * T_world_lidar};
-    track.recent.pop_front();
-    // Eq 3.4: both motions of a rigid rig share the screw angle and pitch; a pair
-    // that does not (an odometry error) is kept out (measured: 26 of 75 on rhd handheld).
-    if (calib::screw_residual(pair, calib::HandEyeConfig{}).inlier) track.hand_eye.add(pair);
-  }
-  track.report.initialization = track.hand_eye.status();
-  if (track.hand_eye.status().state != calib::OnlineHandEyeState::ready) return;
-  track.setup.T_base_lidar = track.hand_eye.status().T_base_lidar;
-  track.role = LidarRole::calibrating;
-  track.report.initialized_frame = frame_index;
-  track.own.reset();
-  out.role = track.role;
-}
-
 void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std::size_t frame_index, SlamLidarFrame& out) {
   Track& track = *tracks_[j];
   // The scan is deskewed once the next frame's pose is known, with the
@@ -202,6 +132,7 @@ void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std
   out.accepted = verdict.accepted;
   track.report.weak = monitor_.lidar(j).weak;
   if (verdict.accepted) track.setup.T_base_lidar = window.T_base_lidar;
+  if (verdict.accepted) track.high_residual_windows = 0;
   track.report.accepted = monitor_.lidar(j).accepted.size();
   if (!verdict.converged_now) return;
   // Algorithm 1 lines 8-11: the mean of L_calib accepted estimates, covariance alpha Xi_calib.
@@ -221,6 +152,7 @@ void SlamEstimator::make_untrusted(std::size_t j) {
   Track& track = *tracks_[j];
   track.role = LidarRole::initializing;
   track.hand_eye.reset();
+  track.rotation_only_pairs = 0;
   monitor_.restart(j);
   track.T_g_lidar = SE3(track.setup.T_base_lidar.rotation(), Vec3::Zero());
   track.own.reset();  // restarted at its next scan, with up from that scan's ground (restart_own_odometry)
@@ -294,7 +226,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
     start = Clock::now();
     if (tracks_[j]->role == LidarRole::initializing) {
       if (!tracks_[j]->own) restart_own_odometry(j, *scans[j]);
-      initialize(j, stamp, *scans[j], k, out.lidars[j]);
+      initialize(j, stamp, *scans[j], scans[0] ? &*scans[0] : nullptr, k, out.lidars[j]);
       out.seconds.initialization += seconds_since(start);
     } else if (tracks_[j]->role == LidarRole::calibrating && !last_odometry_.lost) {
       calibrate(j, stamp, *scans[j], k, out.lidars[j]);
@@ -303,6 +235,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   }
   start = Clock::now();
   detect_shocks(k, out);
+  check_reinitialization(k, out);
   out.seconds.shock = seconds_since(start);
   if (trusted_changed_) {
     odometry_->set_lidars(trusted_setups());  // from the next frame on; the map and world are kept

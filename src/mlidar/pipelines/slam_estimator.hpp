@@ -7,8 +7,12 @@
 //   - initialization of each untrusted LiDAR j (eq 4.15-4.18): its own
 //     odometry gives B_k, the trusted poses give A_k, for
 //     frames 5 apart (one overlapping pair per frame), into
-//     calib::OnlineHandEye until it is ready
-//     (under planar motion t along the rotation axis is fixed to 0, flagged);
+//     calib::OnlineHandEye until it is ready (a pair failing eq 3.4's pitch
+//     test gives its rotation only; with the rotation but no translation for
+//     StartParams::zero_translation_after_pairs pairs, the window starts
+//     from t = 0; under planar motion eq 3.8-3.12 and the ground planes give
+//     the start and the unobservable directions are reported)
+//     (slam_start.cpp);
 //   - online calibration of j (eq 4.21): j's features (deskewed, in its own
 //     frame) on the last N + 1 frames, whose poses the trusted map fixes, are
 //     matched against that map and the window is solved for T_base_lidar_j;
@@ -17,6 +21,9 @@
 //     trusted set with covariance alpha Xi_calib (calib::calibration_covariance:
 //     the accepted estimates' scatter over their effective sample size, tau
 //     at least N + 1, plus the windows' own sigma^2 Lambda^-1);
+//   - re-initialization: a calibrating LiDAR whose windows, none accepted,
+//     keep a map residual above StartParams's ratio times the base's goes
+//     back to initialization (its hand-eye start was wrong);
 //   - extrinsic shock: each trusted LiDAR's mean residual against the map per
 //     frame feeds calib::ShockDetector; a trigger sends that LiDAR back to
 //     initialization (hand-eye and Algorithm 1 restarted; its own odometry
@@ -74,6 +81,7 @@ struct SlamLidarFrame {
   double window_residual_variance_m2 = -1.0;  ///< its residual variance per row (-1: no window)
   double mean_residual_m = -1.0;   ///< against the map (-1: none)
   bool shock = false;              ///< the re-calibration trigger fired
+  bool reinitialized = false;      ///< sent back to initialization (window residuals high, none accepted)
 };
 
 struct SlamFrame {
@@ -102,6 +110,11 @@ struct SlamLidarReport {
   std::vector<std::size_t> shock_frames;
   std::size_t missing_frames = 0;
   std::vector<calib::WeakDirection> weak;  ///< directions of the last window below lambda_calib
+  std::vector<std::size_t> reinitialization_frames;  ///< frames where a calibrating LiDAR went back to initialization
+  /// Extrinsic directions the motion left unobservable at the last hand-eye start (planar motion), in words.
+  std::vector<std::string> unobservable_from_motion;
+  std::string axis_translation_source;  ///< planar: "ground planes" or "set to 0"; else empty
+  std::string translation_start;  ///< "hand_eye" or "zero" (not solvable from motion) at the last start; empty before
 };
 
 class SlamEstimator {
@@ -128,7 +141,9 @@ class SlamEstimator {
   void run_trusted_odometry(double stamp, const std::vector<std::optional<Scan>>& scans, SlamFrame& out);
   /// The trusted LiDARs' setups; sets trusted_ to their indices.
   std::vector<slam::LidarSetup> trusted_setups();
-  void initialize(std::size_t j, double stamp, const Scan& scan, std::size_t frame_index, SlamLidarFrame& out);
+  void initialize(std::size_t j, double stamp, const Scan& scan, const Scan* base_scan, std::size_t frame_index, SlamLidarFrame& out);
+  void set_planar_height(Track& track);
+  void check_reinitialization(std::size_t frame_index, SlamFrame& out);
   void calibrate(std::size_t j, double stamp, const Scan& scan, std::size_t frame_index, SlamLidarFrame& out);
   void detect_shocks(std::size_t frame_index, SlamFrame& out);
   void make_untrusted(std::size_t j);

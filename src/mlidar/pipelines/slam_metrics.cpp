@@ -39,7 +39,8 @@ nlohmann::json lidar_frame_json(const SlamLidarFrame& l) {
           {"accepted", l.accepted}, {"mean_residual_m", number_or_null(l.mean_residual_m)}, {"shock", l.shock},
           {"window_information", l.window_information ? nlohmann::json(std::vector<double>(l.window_information->data(), l.window_information->data() + 36))
                                                       : nlohmann::json(nullptr)},
-          {"window_residual_variance_m2", number_or_null(l.window_residual_variance_m2)}};
+          {"window_residual_variance_m2", number_or_null(l.window_residual_variance_m2)},
+          {"reinitialized", l.reinitialized}};
 }
 
 nlohmann::json matrix_json_6(const Mat6& m) { return std::vector<double>(m.data(), m.data() + 36); }
@@ -52,6 +53,7 @@ nlohmann::json covariance_terms_json(const std::optional<calib::CalibrationCovar
 }
 
 nlohmann::json lidar_report_json(const SlamLidarReport& l) {
+  const auto window_observed = [](const SlamLidarReport& r) { return r.converged_frame.has_value() || r.accepted > 0; };
   const auto& init = l.initialization;
   nlohmann::json weak = nlohmann::json::array();
   for (const auto& w : l.weak) weak.push_back({{"description", w.description}, {"eigenvalue", w.eigenvalue}});
@@ -73,11 +75,19 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
             {"translation_eigenvalues", init.translation_eigenvalues},
             {"rotation_rms_rad", init.rotation_rms_rad},
             {"planar_motion", init.planar_motion},
+            {"pairs_translation", init.pairs_translation},
+            {"translation_std_m", number_or_null(init.translation_std_m)},
+            {"planar_rotation", init.planar_rotation},
+            {"translation_start", l.translation_start.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.translation_start)},
+            {"unobservable_from_motion", l.unobservable_from_motion},
+            {"axis_translation_source", l.axis_translation_source.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.axis_translation_source)},
+            {"observable_in_window", l.unobservable_from_motion.empty() ? nlohmann::json(nullptr) : nlohmann::json(window_observed(l))},
             {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}}}},
           {"converged_frame", optional_json(l.converged_frame)},
           {"accepted", l.accepted},
           {"restarts", l.restarts},
           {"shock_frames", l.shock_frames},
+          {"reinitialization_frames", l.reinitialization_frames},
           {"missing_frames", l.missing_frames},
           {"weak_directions", weak}};
 }
