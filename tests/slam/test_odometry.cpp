@@ -83,6 +83,40 @@ TEST(Odometry, UsesBothLidarsOfATwoLidarRig) {
   EXPECT_GT(second.plane_features, 0u);
 }
 
+TEST(Odometry, ReusedCorrespondencesMatchSearchingEveryIterationAndResidualsSplitPerLidar) {
+  // rematch_distance_m reuses a feature's map fit while it moves < 2 cm: the
+  // pose must agree with a search every iteration (rematch 0) well inside both
+  // errors' bound (1 cm, as UsesBothLidarsOfATwoLidarRig; measured 2.0 mm apart on
+  // this one-scan map).
+  const SE3 motion(so3_exp(Vec3(0.0, 0.0, -0.08)), Vec3(0.5, -0.2, 0.0));
+  const TwoFrames data = simulate_pair("rhd", "campus", motion, 0.005);
+  OdometryConfig every_iteration;
+  every_iteration.registration.rematch_distance_m = 0.0;
+  Odometry reference(every_iteration, data.lidars);
+  Odometry reusing({}, data.lidars);
+  const FrameResult first = reusing.process(data.first);
+  reference.process(data.first);
+  const FrameResult expected = reference.process(data.second);
+  const FrameResult second = reusing.process(data.second);
+  const SE3 difference = expected.T_world_base.inverse() * second.T_world_base;
+  EXPECT_LT(difference.translation().norm(), 0.005);
+  EXPECT_LT(angle_deg(difference), 0.02);
+  EXPECT_LT((motion.inverse() * second.T_world_base).translation().norm(), 0.01);
+  // One residual per query; finite exactly for the matches; per-LiDAR means weighted back give the overall mean.
+  const RegistrationResult& registration = second.registration;
+  ASSERT_EQ(registration.residuals_m.size(), registration.queries);
+  std::size_t finite = 0;
+  for (const float r : registration.residuals_m) finite += std::isfinite(r) ? 1U : 0U;
+  EXPECT_EQ(finite, registration.plane_matches + registration.edge_matches);
+  ASSERT_EQ(second.lidar_mean_residual_m.size(), data.lidars.size());
+  for (const double mean : second.lidar_mean_residual_m) {
+    EXPECT_TRUE(std::isfinite(mean));
+    EXPECT_GE(mean, 0.0);
+    EXPECT_LT(mean, 0.05);
+  }
+  for (const double mean : first.lidar_mean_residual_m) EXPECT_TRUE(std::isnan(mean));
+}
+
 TEST(Odometry, SurvivesALargeTurnByRetryingYaw) {
   // The wider BALM sequence turns up to 48 deg between keyframes.
   for (const double yaw_deg : {48.0, -48.0}) {

@@ -21,8 +21,6 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 /// hand-eye start may be a degree and centimetres off (0.5 m at 30 m range),
 /// the second pass matches at the first pass's solution.
 constexpr std::array<double, 2> kCalibrationGatesM = {1.0, 0.3};
-/// Mean residual gate (m) of the shock score: a shifted LiDAR's features must still match.
-constexpr double kShockGateM = 1.0;
 
 /// The trusted LiDARs' scans at `stamp`; a missing one is an empty scan (it contributes no features).
 Frame trusted_frame(double stamp, const std::vector<std::optional<Scan>>& scans, const std::vector<std::size_t>& trusted) {
@@ -176,13 +174,14 @@ void SlamEstimator::restart_own_odometry(std::size_t j, const Scan& scan) {
 }
 
 void SlamEstimator::detect_shocks(std::size_t frame_index, SlamFrame& out) {
+  // The registration's own residuals at its last linearisation (its gate is the
+  // adaptive correspondence threshold): no second search of the map.
   std::vector<double> residual(tracks_.size(), std::numeric_limits<double>::quiet_NaN());
-  const slam::MapView map{odometry_->edge_map(), odometry_->plane_map(), config_.odometry.registration};
-  const auto& features = odometry_->lidar_features();
-  for (std::size_t i = 0; i < trusted_.size(); ++i) {
+  const std::vector<double>& registered = last_odometry_.lidar_mean_residual_m;
+  for (std::size_t i = 0; i < trusted_.size() && i < registered.size(); ++i) {
     const std::size_t j = trusted_[i];
     if (out.lidars[j].scan_missing || last_odometry_.lost) continue;
-    residual[j] = slam::map_fit(features[i].edges, features[i].planes, last_odometry_.registration.T_world_base, map, kShockGateM).mean_residual_m();
+    residual[j] = registered[i];
     out.lidars[j].mean_residual_m = std::isfinite(residual[j]) ? residual[j] : -1.0;
   }
   for (const std::size_t j : shock_.update(residual)) {

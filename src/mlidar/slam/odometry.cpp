@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <numbers>
 #include <stdexcept>
 
@@ -41,6 +43,37 @@ void append_features(const LidarFeatures& from, LidarFeatures& to) {
   else to.edge_times.insert(to.edge_times.end(), from.edge_times.begin(), from.edge_times.end());
   if (from.plane_times.empty()) to.plane_times.resize(to.planes.size(), 0.0F);
   else to.plane_times.insert(to.plane_times.end(), from.plane_times.begin(), from.plane_times.end());
+}
+
+/// Adds the finite values of `values` to sum and count.
+void add_finite(std::span<const float> values, double& sum, std::size_t& count) {
+  for (const float v : values) {
+    if (!std::isfinite(v)) continue;
+    sum += v;
+    ++count;
+  }
+}
+
+/// Mean |r| of the matched features of each LiDAR at the registration's last
+/// linearisation (NaN: none); `residuals` holds all edges, then all planes, LiDAR after LiDAR.
+std::vector<double> mean_residual_per_lidar(const std::vector<LidarFeatures>& lidars, std::span<const float> residuals) {
+  std::vector<double> means(lidars.size(), std::numeric_limits<double>::quiet_NaN());
+  std::size_t edge_begin = 0;
+  std::size_t plane_begin = 0;
+  for (const LidarFeatures& f : lidars) plane_begin += f.edges.size();
+  for (std::size_t i = 0; i < lidars.size(); ++i) {
+    const std::size_t edges = lidars[i].edges.size();
+    const std::size_t planes = lidars[i].planes.size();
+    if (plane_begin + planes > residuals.size()) break;  // no registration (first frame)
+    double sum = 0.0;
+    std::size_t count = 0;
+    add_finite(residuals.subspan(edge_begin, edges), sum, count);
+    add_finite(residuals.subspan(plane_begin, planes), sum, count);
+    if (count > 0) means[i] = sum / static_cast<double>(count);
+    edge_begin += edges;
+    plane_begin += planes;
+  }
+  return means;
 }
 
 void clear_features(LidarFeatures& f) {
@@ -178,6 +211,7 @@ FrameResult Odometry::process(const Frame& frame) {
     T_world_centroid = result.registration.T_world_base;
     result.lost = result.registration.match_ratio() < config_.lost_match_ratio ||
                   result.registration.mean_residual_m > config_.trusted_mean_residual_m;
+    result.lidar_mean_residual_m = mean_residual_per_lidar(features_, result.registration.residuals_m);
     if (result.lost) T_world_centroid = prediction;  // flagged, not silently trusted
     else if ((prediction.inverse() * centroid_poses_.back().T_world_base).translation().norm() >= config_.min_motion_m)
       adapt_threshold(prediction, T_world_centroid);

@@ -67,6 +67,9 @@ struct FrameResult {
   double threshold_m = 0.0;
   bool retried = false;
   bool lost = false;
+  /// Per LiDAR (construction order): mean |r| of its matched features at the
+  /// registration's last linearisation; NaN when it matched none (and on the first frame).
+  std::vector<double> lidar_mean_residual_m;
 };
 
 class Odometry {

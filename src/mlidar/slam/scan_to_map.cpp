@@ -1,5 +1,9 @@
 #include "mlidar/slam/scan_to_map.hpp"
 
+#include <limits>
+#include <optional>
+#include <vector>
+
 #include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
@@ -31,6 +35,22 @@ struct NormalEquations {
   }
 };
 
+/// A feature's last map search: where it was (world) and what it found.
+template <typename Model>
+struct CachedMatch {
+  Vec3 where = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());  ///< NaN: never searched
+  std::optional<Model> model;
+};
+
+/// The map correspondences of every feature across iterations: a feature is
+/// searched again only once it has moved more than the rematch distance from
+/// where it was last searched (near convergence the pose moves millimetres and
+/// the same map neighbours come back); the residual is always re-evaluated.
+struct MatchCache {
+  std::vector<CachedMatch<MapLine>> edges;
+  std::vector<CachedMatch<PlaneCoefficients>> planes;
+};
+
 struct Matcher {
   const VoxelMap& edge_map;
   const VoxelMap& plane_map;
@@ -39,22 +59,38 @@ struct Matcher {
   float neighborhood_sq;    ///< squared search radius for the map neighbours
   double max_residual_m;    ///< correspondences with a larger |r| are rejected
   double huber_delta;
+  double rematch_sq;        ///< squared rematch distance
+  MatchCache& cache;        ///< each feature's entry is touched by one task only
+  std::span<float> residuals;  ///< |r| per query (edges, then planes), NaN when unmatched
 
-  void plane(const Eigen::Vector3f& p, NormalEquations& eq) const {
+  template <typename Model, typename Search>
+  const std::optional<Model>& lookup(CachedMatch<Model>& cached, const Vec3& q, Search search) const {
+    if (!((q - cached.where).squaredNorm() <= rematch_sq)) {
+      cached.where = q;
+      cached.model = search();
+    }
+    return cached.model;
+  }
+
+  void plane(std::size_t i, const Eigen::Vector3f& p, NormalEquations& eq) const {
+    residuals[cache.edges.size() + i] = std::numeric_limits<float>::quiet_NaN();
     const Vec3 q = T * Vec3(p.cast<double>());
-    const std::optional<PlaneCoefficients> plane = match_plane(plane_map, q, neighborhood_sq, config);
+    const std::optional<PlaneCoefficients>& plane =
+        lookup(cache.planes[i], q, [&] { return match_plane(plane_map, q, neighborhood_sq, config); });
     if (!plane) return;
     Vec3 r;
     Mat36 J;
     plane_residual(*plane, q, r, J);
     if (r.norm() > max_residual_m) return;
     eq.add(r, J, huber_weight(r.norm(), huber_delta));
+    residuals[cache.edges.size() + i] = static_cast<float>(r.norm());
     ++eq.planes;
   }
 
-  void edge(const Eigen::Vector3f& p, NormalEquations& eq) const {
+  void edge(std::size_t i, const Eigen::Vector3f& p, NormalEquations& eq) const {
+    residuals[i] = std::numeric_limits<float>::quiet_NaN();
     const Vec3 q = T * Vec3(p.cast<double>());
-    const std::optional<MapLine> line = match_line(edge_map, q, neighborhood_sq, config);
+    const std::optional<MapLine>& line = lookup(cache.edges[i], q, [&] { return match_line(edge_map, q, neighborhood_sq, config); });
     if (!line) return;
     const EdgePlanes planes = edge_planes(line->point, line->direction, q);
     Eigen::Matrix<double, 6, 1> r;
@@ -69,6 +105,7 @@ struct Matcher {
     J.bottomRows<3>() = J1;
     if (r.norm() > max_residual_m) return;
     eq.add(r, J, huber_weight(r.norm(), huber_delta));
+    residuals[i] = static_cast<float>(r.norm());
     ++eq.edges;
   }
 };
@@ -80,9 +117,9 @@ NormalEquations linearise(std::span<const Eigen::Vector3f> edges, std::span<cons
       [&](const tbb::blocked_range<std::size_t>& range, NormalEquations eq) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           if (i < edges.size()) {
-            matcher.edge(edges[i], eq);
+            matcher.edge(i, edges[i], eq);
           } else {
-            matcher.plane(planes[i - edges.size()], eq);
+            matcher.plane(i - edges.size(), planes[i - edges.size()], eq);
           }
         }
         return eq;
@@ -114,10 +151,13 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_b
   RegistrationResult result;
   result.T_world_base = initial;
   result.queries = edges_base.size() + planes_base.size();
+  result.residuals_m.assign(result.queries, std::numeric_limits<float>::quiet_NaN());
   const double radius = std::max(max_correspondence_m, config.neighborhood_radius_m);
   const auto neighborhood_sq = static_cast<float>(radius * radius);
+  MatchCache cache{std::vector<CachedMatch<MapLine>>(edges_base.size()), std::vector<CachedMatch<PlaneCoefficients>>(planes_base.size())};
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
-    const Matcher matcher{edge_map, plane_map, result.T_world_base, config, neighborhood_sq, max_correspondence_m, config.huber_delta_m};
+    const double rematch_sq = config.rematch_distance_m * config.rematch_distance_m;
+    const Matcher matcher{edge_map, plane_map, result.T_world_base, config, neighborhood_sq, max_correspondence_m, config.huber_delta_m, rematch_sq, cache, result.residuals_m};
     const NormalEquations eq = linearise(edges_base, planes_base, matcher);
     result.iterations = iteration + 1;
     result.plane_matches = eq.planes;

@@ -2,7 +2,8 @@
 // Scan-to-map registration of base-frame features against the local maps
 // (thesis eq 4.9 with the residuals of eq 4.7/4.8, Huber loss), solved by
 // iteratively reweighted Gauss-Newton on SE(3) with the left update
-// T <- Exp(delta) T. Correspondences are re-found every iteration: a plane
+// T <- Exp(delta) T. Correspondences are re-found every iteration (see
+// rematch_distance_m for the exception): a plane
 // point takes its k nearest plane-map points within
 // max(max_correspondence_m, neighborhood_radius_m) (the search radius follows
 // the map's density; the pose uncertainty gates the residual instead: a
@@ -10,7 +11,8 @@
 // neighbour lies within plane_tolerance of it and they are not colinear), an edge point its k nearest
 // edge-map points (a line when the largest eigenvalue exceeds
 // edge_linearity x the middle one and every neighbour lies within
-// edge_tolerance of the line). Normal equations are summed with
+// edge_tolerance of the line); a feature that moved less than
+// rematch_distance_m since its last search keeps its fitted plane or line. Normal equations are summed with
 // tbb::parallel_reduce. Degeneracy (Zhang, Kaess & Singh, ICRA 2016): the
 // translation block of H is sum w n n^T over the residual normals; when the
 // ratio of its smallest to largest eigenvalue (scale-free: independent of the
@@ -18,6 +20,7 @@
 // smallest one's eigenvector is dropped (the prediction is kept there) and
 // the result says so.
 #include <span>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -39,6 +42,10 @@ struct RegistrationConfig {
   double edge_tolerance_m = 0.1;    ///< every edge neighbour within this of the fitted line
   /// Measured (rv rig, 40 frames each): campus 0.19-0.35, corridor 0.03-0.05.
   double degeneracy_threshold = 0.1;
+  /// A feature's map neighbours are searched again only after it moved this far
+  /// (world) since its last search; closer, the last fit (plane or line) is reused
+  /// and only the residual re-evaluated. 0 searches every iteration.
+  double rematch_distance_m = 0.02;
 };
 
 struct RegistrationResult {
@@ -53,6 +60,9 @@ struct RegistrationResult {
   Vec6 eigenvalues = Vec6::Zero();  ///< of hessian, ascending
   double translation_observability = 0.0;  ///< lambda_min(H_tt) / lambda_max(H_tt), in [0, 1]
   bool degenerate = false;
+  /// |r| of each query (edges, then planes, in the order given) at the last
+  /// linearisation; NaN where it had no correspondence within the gate.
+  std::vector<float> residuals_m;
 
   double match_ratio() const { return queries == 0 ? 0.0 : static_cast<double>(plane_matches + edge_matches) / static_cast<double>(queries); }
 };
