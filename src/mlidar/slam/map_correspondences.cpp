@@ -68,11 +68,4 @@ MapFit add_map_correspondences(const LidarFrameFeatures& features, int frame, in
       });
 }
 
-MapFit map_fit(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const SE3& T_world_points,
-               const MapView& map, double max_residual_m) {
-  return match_all(
-      edges, planes, T_world_points, map, max_residual_m, [](const Eigen::Vector3f&, const PlaneCoefficients&) {},
-      [](const Eigen::Vector3f&, const MapLine&) {});
-}
-
 }  // namespace mlidar::slam

@@ -42,8 +42,4 @@ struct MapFit {
 MapFit add_map_correspondences(const LidarFrameFeatures& features, int frame, int lidar, const SE3& T_world_lidar, const MapView& map,
                                double max_residual_m, WindowProblem& problem);
 
-/// The fit alone (nothing stored).
-MapFit map_fit(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const SE3& T_world_points,
-               const MapView& map, double max_residual_m);
-
 }  // namespace mlidar::slam
