@@ -1,4 +1,5 @@
 // Algorithm 1 (thesis Sec. 4.7.4) on constructed information matrices.
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -92,6 +93,24 @@ TEST(ConvergenceMonitor, WindowCovariancesEnterXiCalibWhenTheResidualVarianceIsG
   EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(expected, 1e-9));
   EXPECT_DOUBLE_EQ(monitor.lidar(0).covariance_parts.autocorrelation_time, 4.0);  // the floor 5 clamped to n
   EXPECT_THROW(ConvergenceMonitor({kTruth}, ConvergenceConfig{70.0, 25, 0.5}), std::invalid_argument);
+}
+
+TEST(ConvergenceMonitor, SharedErrorFloorIsAddedPerAxis) {
+  ConvergenceConfig config;
+  config.accepted_needed = 4;
+  config.bias_translation_sd_m = 0.015;
+  config.bias_rotation_sd_deg = 0.1;
+  ConvergenceMonitor monitor({kTruth}, config);
+  const Mat6 information = information_with_min(100.0, 3);
+  for (int window = 0; window < 4; ++window) monitor.add_window(0, kTruth, information, 1e-3);
+  ASSERT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
+  const CalibrationCovariance& parts = monitor.lidar(0).covariance_parts;
+  Vec6 variance;
+  variance << Vec3::Constant(0.015 * 0.015), Vec3::Constant(std::pow(0.1 * 3.141592653589793 / 180.0, 2));
+  EXPECT_TRUE(parts.bias.isApprox(Mat6(variance.asDiagonal()), 1e-12));
+  EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(parts.spread + parts.windows + parts.bias, 1e-12));
+  // Identical estimates: however many windows agree, the 1-sigma never drops below the floor.
+  EXPECT_GE(monitor.lidar(0).covariance(0, 0), 0.015 * 0.015);
 }
 
 TEST(ExtrinsicMean, SymmetricSamplesGiveTheCentreAndTheAnalyticCovariance) {

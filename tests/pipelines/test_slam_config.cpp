@@ -21,6 +21,8 @@ TEST(SlamConfig, DefaultsAreTable42) {
   EXPECT_EQ(c.initialization.rotation_threshold, 0.25);  // sigma_R
   EXPECT_EQ(c.convergence.lambda_calib, 70.0);
   EXPECT_EQ(c.convergence.accepted_needed, 25u);         // L_calib
+  EXPECT_EQ(c.convergence.bias_translation_sd_m, 0.01);   // measured shared-error floor (docs/benchmarks.md)
+  EXPECT_EQ(c.convergence.bias_rotation_sd_deg, 0.04);
   EXPECT_EQ(c.window.size, 4);                           // N
   EXPECT_EQ(c.window.pivot, 2);                          // p
   EXPECT_EQ(c.window.uncertainty_threshold, 100.0);      // w
@@ -37,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 30u);
+  EXPECT_EQ(slam_config_keys().size(), 32u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/rotation_average.hpp"
 
 namespace mlidar::calib {
@@ -140,6 +141,10 @@ WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_bas
   const bool all_windows = state.accepted_covariances.size() == state.accepted.size();
   state.covariance_parts = calibration_covariance(mean.local_deviations, all_windows ? std::span<const Mat6>(state.accepted_covariances) : std::span<const Mat6>(),
                                                   config_.min_autocorrelation_time);
+  Vec6 bias_sd;
+  bias_sd << Vec3::Constant(config_.bias_translation_sd_m), Vec3::Constant(deg_to_rad(config_.bias_rotation_sd_deg));
+  state.covariance_parts.bias = bias_sd.cwiseAbs2().asDiagonal();
+  state.covariance_parts.total += state.covariance_parts.bias;
   state.covariance = state.covariance_parts.total;
   state.mode = CalibrationMode::converged;
   verdict.converged_now = true;

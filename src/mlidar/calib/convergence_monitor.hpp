@@ -34,6 +34,11 @@ struct ConvergenceConfig {
   /// Floor of the accepted estimates' autocorrelation time in Xi_calib: the
   /// frames a window spans (N + 1), as consecutive windows share N of them.
   double min_autocorrelation_time = 1.0;
+  /// Per-axis 1-sigma of an error all windows of a run share (the map and
+  /// poses they are matched against), added to Xi_calib: no statistic of the
+  /// windows can see it. 0: none.
+  double bias_translation_sd_m = 0.0;
+  double bias_rotation_sd_deg = 0.0;
 };
 
 /// One eigen-direction of an information matrix.

@@ -36,9 +36,10 @@ double integrated_autocorrelation_time(std::span<const Vec6> deviations);
 Mat6 local_covariance_from_left_information(const SE3& T, const Mat6& information, double residual_variance);
 
 struct CalibrationCovariance {
-  Mat6 total = Mat6::Zero();       ///< spread + windows
+  Mat6 total = Mat6::Zero();       ///< spread + windows + bias
   Mat6 spread = Mat6::Zero();      ///< S tau / n
   Mat6 windows = Mat6::Zero();     ///< mean of the windows' own covariances
+  Mat6 bias = Mat6::Zero();        ///< shared-error floor (ConvergenceConfig::bias_*), added by the monitor
   double autocorrelation_time = 1.0;  ///< tau used (>= min_tau)
 };
 

@@ -40,7 +40,8 @@ struct SlamConfig {
   /// Eq 4.15-4.18; measured defaults beyond the thesis: the translation's predicted std gate and the planar start.
   calib::OnlineHandEyeConfig initialization{.translation_max_std_m = 0.1, .planar_rotation = true};
   StartParams start;
-  calib::ConvergenceConfig convergence;       ///< Algorithm 1
+  /// Algorithm 1; the shared-error floor measured on the simulated protocol (docs/benchmarks.md "Extrinsic covariance").
+  calib::ConvergenceConfig convergence{.bias_translation_sd_m = 0.01, .bias_rotation_sd_deg = 0.04};
   WindowParams window;
   calib::ShockDetectorConfig shock;           ///< re-calibration trigger
   slam::OdometryConfig odometry;              ///< front end and scan-to-map registration

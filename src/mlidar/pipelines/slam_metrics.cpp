@@ -48,7 +48,7 @@ nlohmann::json matrix_json_6(const Mat6& m) { return std::vector<double>(m.data(
 /// Xi_calib's terms (calib/extrinsic_covariance.hpp), null before convergence.
 nlohmann::json covariance_terms_json(const std::optional<calib::CalibrationCovariance>& parts) {
   if (!parts) return nullptr;
-  return {{"autocorrelation_time", parts->autocorrelation_time}, {"spread", matrix_json_6(parts->spread)},
+  return {{"autocorrelation_time", parts->autocorrelation_time}, {"spread", matrix_json_6(parts->spread)}, {"bias", matrix_json_6(parts->bias)},
           {"windows", matrix_json_6(parts->windows)}};
 }
 
