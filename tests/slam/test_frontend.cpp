@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <random>
 #include <set>
 
@@ -160,6 +161,83 @@ TEST(Features, CurvatureOfAFlatRowIsZero) {
   for (int i = 5; i < 15; ++i) EXPECT_FLOAT_EQ(curvature[static_cast<std::size_t>(i)], 0.0F);
   EXPECT_TRUE(std::isinf(curvature[0]));
   EXPECT_TRUE(std::isinf(curvature[19]));
+}
+
+// The LOAM selection rule written out with one full sort per sector: the
+// oracle for extract_features' lazy partial ordering (thresholds 0: every
+// pixel is a candidate, so the picks run deep into each sector's order).
+FeatureIndices select_by_full_sort(std::span<const float> curvature, std::span<const std::uint8_t> ground, const FeatureConfig& config) {
+  FeatureIndices out;
+  const int n = static_cast<int>(curvature.size());
+  std::vector<std::uint8_t> blocked(curvature.size(), 0);
+  const auto block = [&](int i) { for (int k = std::max(0, i - 5); k <= std::min(n - 1, i + 5); ++k) blocked[static_cast<std::size_t>(k)] = 1; };
+  for (int s = 0; s < config.sectors; ++s) {
+    std::vector<int> order;
+    for (int i = 5 + (n - 10) * s / config.sectors; i < 5 + (n - 10) * (s + 1) / config.sectors; ++i) order.push_back(i);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return curvature[static_cast<std::size_t>(a)] > curvature[static_cast<std::size_t>(b)]; });
+    int edges = 0, planes = 0;
+    for (const int i : order)
+      if (edges < config.edges_per_sector && blocked[static_cast<std::size_t>(i)] == 0 && ground[static_cast<std::size_t>(i)] == 0) {
+        out.edges.push_back(static_cast<std::uint32_t>(i));
+        block(i);
+        ++edges;
+      }
+    for (auto it = order.rbegin(); it != order.rend(); ++it)
+      if (planes < config.planes_per_sector && blocked[static_cast<std::size_t>(*it)] == 0) {
+        out.planes.push_back(static_cast<std::uint32_t>(*it));
+        block(*it);
+        ++planes;
+      }
+  }
+  return out;
+}
+
+TEST(Features, LazyOrderingPicksWhatAFullSortPicks) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> range(4.0F, 6.0F);
+  RangeImage image;
+  image.rows = 1;
+  image.cols = 400;
+  Segmentation seg;
+  std::vector<std::uint8_t> ground;
+  for (int col = 0; col < image.cols; ++col) {
+    image.range.push_back(range(rng));
+    image.index.push_back(col);
+    ground.push_back(col % 7 == 0 ? 1 : 0);
+    seg.label.push_back(ground.back() != 0 ? Segmentation::kGround : 1);
+  }
+  std::vector<float> curvature(image.range.size());
+  row_curvature(image.range, curvature);
+  FeatureConfig config;
+  config.sectors = 3;
+  config.edges_per_sector = 5;
+  config.planes_per_sector = 9;  // 3 x (5 + 9) picks blocking 11 pixels each: about all of the row
+  config.edge_threshold = 0.0;
+  config.plane_threshold = 1e9;
+  config.occlusion_jump_m = 1e9;
+  config.grazing_ratio = 1e9;
+  FeatureWorkspace ws;
+  FeatureIndices features;
+  extract_features(image, seg, config, ws, features);
+  const FeatureIndices expected = select_by_full_sort(curvature, ground, config);
+  EXPECT_EQ(features.edges, expected.edges);
+  EXPECT_EQ(features.planes, expected.planes);
+  EXPECT_GT(features.planes.size(), 15u);
+}
+
+TEST(RangeImage, FastAtan2MatchesStdAtan2) {
+  double worst = 0.0;
+  for (int i = -1800; i <= 1800; ++i) {
+    const double angle = i * 0.1 * std::numbers::pi / 180.0 + 1e-4 * (i % 7);
+    for (const double radius : {1e-3, 1.0, 150.0}) {
+      const double y = radius * std::sin(angle);
+      const double x = radius * std::cos(angle);
+      worst = std::max(worst, std::abs(fast_atan2(y, x) - std::atan2(y, x)));
+    }
+  }
+  EXPECT_LT(worst, 5e-8);
+  for (const double y : {0.0, -0.0, 1.0, -1.0})
+    for (const double x : {0.0, -0.0, 1.0, -1.0}) EXPECT_NEAR(fast_atan2(y, x), x == 0.0 && y == 0.0 ? 0.0 : std::atan2(y, x), 5e-8) << y << " " << x;
 }
 
 TEST(Deskew, TrueMotionRestoresTheCloud) {

@@ -33,6 +33,25 @@ void block_neighbours(int i, int n, std::span<std::uint8_t> blocked) {
   for (int k = std::max(0, i - kHalfWindow); k <= std::min(n - 1, i + kHalfWindow); ++k) blocked[static_cast<std::size_t>(k)] = 1;
 }
 
+/// Calls visit(i) on `candidates` in `before` order until it returns true or
+/// they run out. Sorts lazily: a chunk (starting at 2 * wanted, doubling) is
+/// selected with nth_element and sorted only when the walk reaches it, since
+/// most picks end within the first few (a full sort per sector was 8 % of slam).
+template <typename Before, typename Visit>
+void walk_in_order(std::vector<std::uint32_t>& candidates, int wanted, Before before, Visit visit) {
+  if (wanted <= 0) return;
+  auto first = candidates.begin();
+  auto chunk = static_cast<std::ptrdiff_t>(2 * wanted);
+  while (first != candidates.end()) {
+    const auto last = candidates.end() - first > chunk ? first + chunk : candidates.end();
+    if (last != candidates.end()) std::nth_element(first, last, candidates.end(), before);
+    std::sort(first, last, before);
+    for (; first != last; ++first)
+      if (visit(*first)) return;
+    chunk *= 2;
+  }
+}
+
 }  // namespace
 
 void row_curvature(std::span<const float> ranges, std::span<float> curvature) {
@@ -75,27 +94,31 @@ void extract_features(const RangeImage& image, const Segmentation& segmentation,
       const int begin = kHalfWindow + (n - 2 * kHalfWindow) * s / config.sectors;
       const int end = kHalfWindow + (n - 2 * kHalfWindow) * (s + 1) / config.sectors;
       if (end <= begin) continue;
-      ws.order.resize(static_cast<std::size_t>(end - begin));
-      for (int i = begin; i < end; ++i) ws.order[static_cast<std::size_t>(i - begin)] = static_cast<std::uint32_t>(i);
-      std::sort(ws.order.begin(), ws.order.end(), [&](std::uint32_t a, std::uint32_t b) { return curvature[a] > curvature[b]; });
+      // Edges: candidates above edge_threshold, highest curvature first.
+      ws.order.clear();
+      for (int i = begin; i < end; ++i)
+        if (curvature[static_cast<std::size_t>(i)] > config.edge_threshold) ws.order.push_back(static_cast<std::uint32_t>(i));
       int edges = 0;
-      for (const std::uint32_t i : ws.order) {
-        if (edges >= config.edges_per_sector || curvature[i] <= config.edge_threshold) break;
-        const std::size_t pixel = ws.pixel[i];
-        if (ws.blocked[i] != 0 || segmentation.label[pixel] == Segmentation::kGround) continue;
-        out.edges.push_back(static_cast<std::uint32_t>(image.index[pixel]));
-        ++edges;
-        block_neighbours(static_cast<int>(i), n, ws.blocked);
-      }
+      walk_in_order(ws.order, config.edges_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] > curvature[b]; },
+                    [&](std::uint32_t i) {
+                      const std::size_t pixel = ws.pixel[i];
+                      if (ws.blocked[i] != 0 || segmentation.label[pixel] == Segmentation::kGround) return false;
+                      out.edges.push_back(static_cast<std::uint32_t>(image.index[pixel]));
+                      block_neighbours(static_cast<int>(i), n, ws.blocked);
+                      return ++edges >= config.edges_per_sector;
+                    });
+      // Planes: candidates below plane_threshold, lowest curvature first.
+      ws.order.clear();
+      for (int i = begin; i < end; ++i)
+        if (curvature[static_cast<std::size_t>(i)] < config.plane_threshold) ws.order.push_back(static_cast<std::uint32_t>(i));
       int planes = 0;
-      for (auto it = ws.order.rbegin(); it != ws.order.rend(); ++it) {
-        const std::uint32_t i = *it;
-        if (planes >= config.planes_per_sector || curvature[i] >= config.plane_threshold) break;
-        if (ws.blocked[i] != 0) continue;
-        out.planes.push_back(static_cast<std::uint32_t>(image.index[ws.pixel[i]]));
-        ++planes;
-        block_neighbours(static_cast<int>(i), n, ws.blocked);
-      }
+      walk_in_order(ws.order, config.planes_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] < curvature[b]; },
+                    [&](std::uint32_t i) {
+                      if (ws.blocked[i] != 0) return false;
+                      out.planes.push_back(static_cast<std::uint32_t>(image.index[ws.pixel[i]]));
+                      block_neighbours(static_cast<int>(i), n, ws.blocked);
+                      return ++planes >= config.planes_per_sector;
+                    });
     }
   }
 }

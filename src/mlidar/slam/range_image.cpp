@@ -16,6 +16,28 @@ int nearest_row(std::span<const double> sorted_angles_deg, double elevation_deg)
   return static_cast<int>(row - sorted_angles_deg.begin());
 }
 
+double fast_atan2(double y, double x) {
+  const double ax = std::abs(x);
+  const double ay = std::abs(y);
+  const double big = std::max(ax, ay);
+  if (big == 0.0) return 0.0;
+  const double t = std::min(ax, ay) / big;  // in [0, 1]
+  const double t2 = t * t;
+  // A&S 4.4.49: atan t = t (1 + a2 t^2 + a4 t^4 + ... + a16 t^16).
+  double poly = 0.0028662257;
+  poly = poly * t2 - 0.0161657367;
+  poly = poly * t2 + 0.0429096138;
+  poly = poly * t2 - 0.0752896400;
+  poly = poly * t2 + 0.1065626393;
+  poly = poly * t2 - 0.1420889944;
+  poly = poly * t2 + 0.1999355085;
+  poly = poly * t2 - 0.3333314528;
+  double angle = t * (1.0 + poly * t2);
+  if (ay > ax) angle = std::numbers::pi / 2.0 - angle;
+  if (x < 0.0) angle = std::numbers::pi - angle;
+  return std::signbit(y) ? -angle : angle;
+}
+
 void build_range_image(std::span<const Eigen::Vector3f> points, std::span<const std::uint16_t> ring,
                        const LidarModel& model, RangeImage& image) {
   if (model.vertical_angles_deg.empty() || !(model.horizontal_resolution_deg > 0.0))
@@ -43,7 +65,7 @@ void build_range_image(std::span<const Eigen::Vector3f> points, std::span<const 
       row = nearest_row(sorted, std::asin(std::clamp(static_cast<double>(p.z()) / range, -1.0, 1.0)) * degrees);
     }
     // Clockwise azimuth, the firing order of spinning sensors (sim/acquisition.hpp).
-    const double azimuth_deg = -std::atan2(static_cast<double>(p.y()), static_cast<double>(p.x())) * degrees;
+    const double azimuth_deg = -fast_atan2(static_cast<double>(p.y()), static_cast<double>(p.x())) * degrees;
     int col = static_cast<int>(std::lround(azimuth_deg * cols_per_degree)) % image.cols;
     if (col < 0) col += image.cols;
     const std::size_t pixel = image.pixel(row, col);

@@ -28,6 +28,11 @@ struct RangeImage {
 /// Row of the table angle nearest to elevation_deg; table sorted ascending, non-empty.
 int nearest_row(std::span<const double> sorted_angles_deg, double elevation_deg);
 
+/// atan2(y, x) in (-pi, pi] from Abramowitz & Stegun 4.4.49 (odd polynomial
+/// of degree 17 on [0, 1], |error| <= 2e-8 rad; octant reduction), about 4x
+/// cheaper than std::atan2. atan2(0, 0) = 0.
+double fast_atan2(double y, double x);
+
 /// Projects `points` (LiDAR frame) into a rows x cols image with
 /// rows = model.rings() and cols = round(360 / horizontal_resolution_deg).
 /// `ring` is empty or one entry per point; ring values >= rows, non-finite
