@@ -55,8 +55,10 @@ struct OdometryConfig {
   std::vector<double> retry_yaw_deg = {15, -15, 30, -30, 45, -45, 60, -60};
   /// After a trusted registration, deskew the frame's features again with the
   /// velocity it measured (the prediction's is a frame late) and register once
-  /// more from there, before they enter the map (docs/benchmarks.md "Back end").
-  bool refine_deskew = true;
+  /// more from there, before they enter the map. Off: it costs a second
+  /// registration (+40-55 % CPU per frame; ATE -10 to -50 % on handheld rhd,
+  /// docs/benchmarks.md "Deskew of the base").
+  bool refine_deskew = false;
 };
 
 struct FrameResult {
