@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 32u);
+  EXPECT_EQ(slam_config_keys().size(), 33u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -66,6 +66,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   c.odometry.local_map_radius_m = 80.0;
   c.odometry.registration.max_iterations = 12;
   c.odometry.registration.huber_delta_m = 0.05;
+  c.odometry.refine_deskew = true;
   const std::string text = slam_config_yaml(c);
   EXPECT_NE(text, slam_config_yaml(SlamConfig{}));
   const SlamConfig back = parse_slam_config(text, "written.yaml");
@@ -78,6 +79,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   EXPECT_TRUE(back.window.refine_odometry);
   EXPECT_EQ(back.odometry.registration.max_iterations, 12);
   EXPECT_EQ(back.odometry.registration.huber_delta_m, 0.05);
+  EXPECT_TRUE(back.odometry.refine_deskew);
 }
 
 struct Rejection {

@@ -274,6 +274,41 @@ TEST(Deskew, TrueMotionRestoresTheCloud) {
   EXPECT_THROW(deskew_to_base(raw, times, bad, T_base_lidar, velocity, std::span(some).first(1)), std::invalid_argument);
 }
 
+// Oracle: deskewing with a wrong (predicted) velocity, then redeskew to the
+// measured one, equals deskewing the raw points with the measured one directly.
+TEST(Deskew, RedeskewEqualsDeskewingWithTheRefinedVelocity) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coord(-20.0, 20.0), when(-0.05, 0.05);
+  BodyVelocity predicted, measured;
+  predicted.linear = Vec3(1.2, 0.1, 0.0);
+  predicted.angular = Vec3(0.0, 0.1, 0.5);
+  measured.linear = Vec3(0.9, -0.3, 0.1);
+  measured.angular = Vec3(0.2, -0.1, 0.8);
+  const SE3 T_base_lidar(so3_exp(Vec3(0.7, 0.0, 0.1)), Vec3(0.0, -0.5, -0.2));
+  std::vector<Eigen::Vector3f> raw;
+  std::vector<float> times;
+  for (int i = 0; i < 300; ++i) {
+    raw.emplace_back(Vec3(coord(rng), coord(rng), coord(rng) / 4.0).cast<float>());
+    times.push_back(static_cast<float>(when(rng)));
+  }
+  std::vector<Eigen::Vector3f> redeskewed(raw.size()), direct(raw.size());
+  deskew_to_base(raw, times, {}, T_base_lidar, predicted, redeskewed);
+  const std::vector<Eigen::Vector3f> before = redeskewed;
+  redeskew(times, predicted, measured, redeskewed);
+  deskew_to_base(raw, times, {}, T_base_lidar, measured, direct);
+  double worst = 0.0, moved = 0.0;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    worst = std::max(worst, static_cast<double>((redeskewed[i] - direct[i]).norm()));
+    moved = std::max(moved, static_cast<double>((before[i] - direct[i]).norm()));
+  }
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_GT(moved, 0.1);  // the two velocities differ enough to matter
+  std::vector<Eigen::Vector3f> unchanged = before;
+  redeskew({}, predicted, measured, unchanged);  // no times: no motion model to undo
+  EXPECT_EQ(unchanged, before);
+  EXPECT_THROW(redeskew(std::span(times).first(3), predicted, measured, unchanged), std::invalid_argument);
+}
+
 TEST(Deskew, VelocityFromRelativePoseRoundTrips) {
   const SE3 relative(so3_exp(Vec3(0.01, 0.02, 0.3)), Vec3(1.0, 0.2, -0.1));
   const BodyVelocity velocity = BodyVelocity::from_relative_pose(relative, 0.1);

@@ -1,6 +1,7 @@
 // Odometry on simulated scans with a known motion between them.
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -210,6 +211,28 @@ TEST(Odometry, FollowsADrivingRigWhoseSweepsAreDistortedByTheMotion) {
   }
   EXPECT_LT(worst_m, 0.1);
   EXPECT_LT(worst_deg, 0.2);
+}
+
+// refine_deskew: the frame deskewed again with the velocity its registration
+// measured and registered once more follows the drive at least as well.
+TEST(Odometry, RefinedDeskewFollowsTheDriveAtLeastAsWell) {
+  const Drive drive = simulate_drive("rv", 12);
+  OdometryConfig refined_config;
+  refined_config.refine_deskew = true;
+  Odometry plain({}, drive.lidars), refined(refined_config, drive.lidars);
+  double plain_sum_m = 0.0, refined_sum_m = 0.0, refined_worst_deg = 0.0;
+  for (std::size_t k = 0; k < drive.frames.size(); ++k) {
+    plain_sum_m += (drive.truth[k].inverse() * plain.process(drive.frames[k]).T_world_base).translation().norm();
+    const FrameResult result = refined.process(drive.frames[k]);
+    EXPECT_FALSE(result.lost) << "frame " << k;
+    const SE3 error = drive.truth[k].inverse() * result.T_world_base;
+    refined_sum_m += error.translation().norm();
+    refined_worst_deg = std::max(refined_worst_deg, angle_deg(error));
+  }
+  std::printf("mean translation error: plain %.4f m, refined %.4f m\n", plain_sum_m / 12.0, refined_sum_m / 12.0);
+  EXPECT_LE(refined_sum_m, 1.05 * plain_sum_m);
+  EXPECT_LT(refined_sum_m / 12.0, 0.05);
+  EXPECT_LT(refined_worst_deg, 0.2);
 }
 
 }  // namespace

@@ -98,6 +98,8 @@ std::vector<Field> fields(SlamConfig& c) {
        &odo.local_map_radius_m},
       {"odometry", "max_iterations", {1, 1000}, "registration iterations per frame",
        &odo.registration.max_iterations},
+      {"odometry", "refine_deskew", {}, "deskew each frame again with the velocity its registration measured and register once more",
+       &odo.refine_deskew},
       {"odometry", "huber_delta_m", {0.0, 100.0, true, false}, "Huber scale on point residuals (eq 4.9's rho)",
        &odo.registration.huber_delta_m},
   };

@@ -44,4 +44,14 @@ void deskew_to_base(std::span<const Eigen::Vector3f> points, std::span<const flo
   }
 }
 
+void redeskew(std::span<const float> times, const BodyVelocity& used, const BodyVelocity& refined, std::span<Eigen::Vector3f> points) {
+  if (times.empty()) return;
+  if (times.size() != points.size()) throw std::invalid_argument("redeskew: times size differs from points");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double tau = times[i];
+    const Vec3 p_base = so3_exp(-tau * used.angular) * (points[i].cast<double>() - tau * used.linear);
+    points[i] = (so3_exp(tau * refined.angular) * p_base + tau * refined.linear).cast<float>();
+  }
+}
+
 }  // namespace mlidar::slam

@@ -36,4 +36,10 @@ void deskew_to_base(std::span<const Eigen::Vector3f> points, std::span<const flo
                     std::span<const std::uint32_t> indices, const SE3& T_base_lidar, const BodyVelocity& velocity,
                     std::span<Eigen::Vector3f> out);
 
+/// Points deskewed with `used` (by deskew_to_base) deskewed again with `refined`:
+/// p = Exp(t w_r) Exp(-t w_u) (p_u - t v_u) + t v_r (the base-frame capture point
+/// recovered, then moved with the refined velocity). times has one entry per point
+/// or is empty (nothing changes); throws std::invalid_argument when sizes disagree.
+void redeskew(std::span<const float> times, const BodyVelocity& used, const BodyVelocity& refined, std::span<Eigen::Vector3f> points);
+
 }  // namespace mlidar::slam

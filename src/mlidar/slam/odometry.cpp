@@ -154,6 +154,19 @@ bool Odometry::trusted(const RegistrationResult& registration) const {
          registration.mean_residual_m <= config_.trusted_mean_residual_m;
 }
 
+void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
+  // Eq 4.12 again with the velocity from the previous centroid to this registration: the
+  // predicted one lags a frame, which left the map (and an auxiliary LiDAR calibrated
+  // against it) with a shared error under handheld motion (docs/benchmarks.md).
+  const StampedPose& previous = centroid_poses_.back();
+  const BodyVelocity measured =
+      BodyVelocity::from_relative_pose(previous.T_world_base.inverse() * result.registration.T_world_base, centroid_stamp - previous.stamp);
+  redeskew(frame_features_.edge_times, used, measured, frame_features_.edges);
+  redeskew(frame_features_.plane_times, used, measured, frame_features_.planes);
+  result.registration = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_,
+                                             result.registration.T_world_base, result.threshold_m, config_.registration);
+}
+
 RegistrationResult Odometry::register_robustly(const SE3& prediction, FrameResult& frame) {
   const double threshold = error_count_ == 0 ? config_.initial_threshold_m
                                              : std::max(config_.min_threshold_m, 3.0 * std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)));
@@ -208,6 +221,7 @@ FrameResult Odometry::process(const Frame& frame) {
     result.registration.converged = true;
   } else {
     result.registration = register_robustly(prediction, result);
+    if (config_.refine_deskew && centroid_poses_.size() >= 2 && trusted(result.registration)) refine_deskew(velocity, centroid_stamp, result);
     T_world_centroid = result.registration.T_world_base;
     result.lost = result.registration.match_ratio() < config_.lost_match_ratio ||
                   result.registration.mean_residual_m > config_.trusted_mean_residual_m;

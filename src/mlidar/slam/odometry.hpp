@@ -53,6 +53,12 @@ struct OdometryConfig {
   double trusted_mean_residual_m = 0.2;
   double lost_match_ratio = 0.5;      ///< below this after retries the frame is lost
   std::vector<double> retry_yaw_deg = {15, -15, 30, -30, 45, -45, 60, -60};
+  /// After a trusted registration, deskew the frame's features again with the
+  /// velocity it measured (the prediction's is a frame late) and register once
+  /// more from there, before they enter the map. Off: it costs a second
+  /// registration (+40-55 % CPU per frame; ATE -10 to -50 % on handheld rhd,
+  /// docs/benchmarks.md "Deskew of the base").
+  bool refine_deskew = false;
 };
 
 struct FrameResult {
@@ -97,6 +103,7 @@ class Odometry {
   BodyVelocity latest_velocity() const;
   RegistrationResult register_robustly(const SE3& prediction, FrameResult& frame);
   bool trusted(const RegistrationResult& registration) const;
+  void refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result);
   void adapt_threshold(const SE3& prediction, const SE3& estimate);
   void update_map(const SE3& T_world_centroid, const LidarFeatures& features);
   /// At the second frame, once a velocity is known: moves the world from the
