@@ -69,7 +69,7 @@ void expect_documented_keys(const nlohmann::json& metrics, int frames) {
   for (const char* key : {"role", "scan_missing", "lambda_min", "accepted", "window_estimate", "mean_residual_m", "shock",
                           "window_information", "window_residual_variance_m2", "reinitialized"})
     EXPECT_TRUE(frame["lidars"]["right"].contains(key)) << key;
-  for (const char* key : {"role", "translation", "quaternion_wxyz", "covariance", "initialization", "converged_frame", "accepted",
+  for (const char* key : {"role", "translation", "quaternion_wxyz", "covariance", "initialization", "converged_frame", "first_converged_frame", "accepted",
                           "restarts", "shock_frames", "missing_frames", "weak_directions", "covariance_terms", "reinitialization_frames"})
     EXPECT_TRUE(metrics["per_lidar"]["right"].contains(key)) << key;
 }
@@ -109,6 +109,7 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   EXPECT_TRUE(right["reinitialization_frames"].empty()) << right["reinitialization_frames"];  // a healthy start is kept
   EXPECT_EQ(right["accepted"].get<int>(), 25);  // L_calib (Table 4.2)
   EXPECT_LT(right["converged_frame"].get<int>(), kFrames);
+  EXPECT_EQ(right["first_converged_frame"], right["converged_frame"]);  // no shock here: one convergence
   // Xi_calib's autocorrelation time is at least the window's N + 1 = 5 frames (clamped to L_calib).
   EXPECT_GE(right["covariance_terms"]["autocorrelation_time"].get<double>(), 5.0);
 

@@ -84,6 +84,7 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
             {"observable_in_window", l.unobservable_from_motion.empty() ? nlohmann::json(nullptr) : nlohmann::json(window_observed(l))},
             {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}}}},
           {"converged_frame", optional_json(l.converged_frame)},
+          {"first_converged_frame", optional_json(l.first_converged_frame)},
           {"accepted", l.accepted},
           {"restarts", l.restarts},
           {"shock_frames", l.shock_frames},
