@@ -91,6 +91,26 @@ TEST(ShockDetector, RelearnsAfterATriggerAndFiresForASecondShock) {
   EXPECT_LT(fired[1].frame, 255);
 }
 
+TEST(ShockDetector, ARiseBelowTheMinimumJumpIsNotAShock) {
+  // The slam default (min_relative_jump 1: 2x): a sustained 1.6x rise of one LiDAR (as in a part of the
+  // simulated room, room seed 6 of the 43 m protocol) does not fire; Table 4.6's shock (residual x6) does.
+  ShockDetectorConfig config;
+  config.min_relative_jump = 1.0;
+  ShockDetector detector(3, config);
+  ResidualStream stream(7);
+  std::vector<Fired> fired;
+  for (int frame = 0; frame < 400; ++frame) {
+    std::vector<double> r = stream.frame();
+    if (frame >= 100 && frame < 200) r[1] *= 1.6;
+    if (frame >= 300) r[1] *= 6.0;
+    for (const std::size_t i : detector.update(r)) fired.push_back({frame, i});
+  }
+  ASSERT_EQ(fired.size(), 1u);
+  EXPECT_EQ(fired[0].lidar, 1u);
+  EXPECT_GE(fired[0].frame, 300);
+  EXPECT_LT(fired[0].frame, 305);
+}
+
 TEST(ShockDetector, SingleLidarUsesItsOwnResidualAndMissingScansAreSkipped) {
   ShockDetector detector(1);
   ResidualStream stream(6);

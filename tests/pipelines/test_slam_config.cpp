@@ -23,6 +23,7 @@ TEST(SlamConfig, DefaultsAreTable42) {
   EXPECT_EQ(c.convergence.accepted_needed, 25u);         // L_calib
   EXPECT_EQ(c.convergence.bias_translation_sd_m, 0.01);   // measured shared-error floor (docs/benchmarks.md)
   EXPECT_EQ(c.convergence.bias_rotation_sd_deg, 0.04);
+  EXPECT_EQ(c.shock.min_relative_jump, 1.0);  // 2x: a 1.5-1.8x rise in part of a room is not a shock
   EXPECT_EQ(c.window.size, 4);                           // N
   EXPECT_EQ(c.window.pivot, 2);                          // p
   EXPECT_EQ(c.window.uncertainty_threshold, 100.0);      // w
@@ -39,7 +40,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 33u);
+  EXPECT_EQ(slam_config_keys().size(), 34u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {

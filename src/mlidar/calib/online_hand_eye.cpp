@@ -216,7 +216,7 @@ void OnlineHandEye::solve_planar_rotation() {
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
     if (translation_valid_[k]) valid.push_back(pairs_[k]);
   }
-  if (valid.size() < std::max<std::size_t>(3, config_.translation_min_pairs)) return;
+  if (pairs_.size() < config_.planar_min_pairs || valid.size() < std::max<std::size_t>(3, config_.translation_min_pairs)) return;
   const Vec3 axis = common_rotation_axis(valid);
   const PlanarSolution planar = solve_planar(valid, axis);
   if (!(planar.condition >= config_.planar_min_condition)) return;

@@ -49,6 +49,9 @@ struct OnlineHandEyeConfig {
   /// translations (eq 3.10-3.12), t along the axis 0 and flagged; off: stay collecting.
   bool planar_rotation = false;
   double planar_min_condition = 1e-3;  ///< eq 3.12 system's s_min / s_max below this: yaw or x, y unobservable
+  /// Fewer stored pairs: no planar start (a few short handheld pairs also turn
+  /// about one axis: 3 pairs after a shock read as planar and started 10 deg off).
+  std::size_t planar_min_pairs = 3;
 };
 
 enum class OnlineHandEyeState { collecting, rotation_ready, ready };

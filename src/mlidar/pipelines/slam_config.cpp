@@ -57,6 +57,8 @@ std::vector<Field> fields(SlamConfig& c) {
        &init.planar_rotation},
       {"initialization", "planar_min_condition", kFraction, "eq 3.12 system's s_min / s_max needed for that start",
        &init.planar_min_condition},
+      {"initialization", "planar_min_pairs", {3, 1e5}, "fewer stored pairs: no planar start (few short pairs share an axis too)",
+       &init.planar_min_pairs},
       {"initialization", "reinitialize_after_windows", {0, 1e5},
        "calibration windows not accepted with a high residual ratio before re-initializing (0: never)",
        &c.start.reinitialize_windows},
