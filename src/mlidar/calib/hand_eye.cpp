@@ -20,21 +20,6 @@ void validate(const HandEyeConfig& c) {
   if (!ok) throw std::invalid_argument("HandEyeConfig: a tolerance is out of range (all > 0, ratio < 1, min_pairs >= 2)");
 }
 
-/// Rotation axes of the inlier A's, sign-aligned with the largest rotation, summed by angle.
-Vec3 common_axis(std::span<const MotionPair> pairs) {
-  Vec3 reference = Vec3::Zero();
-  for (const MotionPair& p : pairs) {
-    const Vec3 phi = so3_log(p.A.rotation());
-    if (phi.norm() > reference.norm()) reference = phi;
-  }
-  Vec3 sum = Vec3::Zero();
-  for (const MotionPair& p : pairs) {
-    const Vec3 phi = so3_log(p.A.rotation());
-    sum += phi.dot(reference) >= 0.0 ? phi : Vec3(-phi);
-  }
-  return sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3::UnitZ();
-}
-
 struct Residuals {
   double rotation_sq = 0.0;
   double translation_sq = 0.0;
@@ -162,7 +147,7 @@ HandEyeResult solve_hand_eye(std::span<const MotionPair> pairs, const HandEyeCon
     result.verdict = HandEyeVerdict::ok;
     result.message = "general motion: rotation and translation observable";
   } else {
-    const Vec3 axis = common_axis(inliers);
+    const Vec3 axis = common_rotation_axis(inliers);
     const PlanarSolution planar = solve_planar(inliers, axis);  // eq 3.8-3.12
     if (planar.condition < config.degenerate_condition) {
       result.verdict = HandEyeVerdict::degenerate_motion;

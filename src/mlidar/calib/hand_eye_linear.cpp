@@ -72,6 +72,20 @@ Vec3 translation_least_squares(std::span<const MotionPair> pairs, const Quat& R_
   return Eigen::JacobiSVD<Mat3>(normal, Eigen::ComputeFullU | Eigen::ComputeFullV).solve(rhs);
 }
 
+Vec3 common_rotation_axis(std::span<const MotionPair> pairs) {
+  Vec3 reference = Vec3::Zero();
+  for (const MotionPair& p : pairs) {
+    const Vec3 phi = so3_log(p.A.rotation());
+    if (phi.norm() > reference.norm()) reference = phi;
+  }
+  Vec3 sum = Vec3::Zero();
+  for (const MotionPair& p : pairs) {
+    const Vec3 phi = so3_log(p.A.rotation());
+    sum += phi.dot(reference) >= 0.0 ? phi : Vec3(-phi);
+  }
+  return sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3::UnitZ();
+}
+
 PlanarSolution solve_planar(std::span<const MotionPair> pairs, const Vec3& axis_a) {
   // Frame a' with z' = axis_a: A' = C A C^-1 and X' = C X.
   const SE3 C(Quat::FromTwoVectors(axis_a.normalized(), Vec3::UnitZ()), Vec3::Zero());

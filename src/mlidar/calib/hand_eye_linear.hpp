@@ -26,6 +26,11 @@ QuaternionSystem quaternion_system(std::span<const MotionPair> pairs, std::span<
 /// Eq 3.3 stacked, rotation known: (R_A - I) t = R t_B - t_A by least squares.
 Vec3 translation_least_squares(std::span<const MotionPair> pairs, const Quat& R_a_b);
 
+/// Unit common rotation axis of the A's (the axis of eq 3.8-3.12): their
+/// rotation vectors sign-aligned with the largest one, summed by angle; z when
+/// none rotates.
+Vec3 common_rotation_axis(std::span<const MotionPair> pairs);
+
 struct PlanarSolution {
   SE3 T_a_b;                 ///< component of t along the axis set to 0
   double condition = 0.0;    ///< s_min / s_max of the column-scaled eq 3.12 system

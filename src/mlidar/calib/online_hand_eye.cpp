@@ -74,19 +74,9 @@ double translation_std(std::span<const MotionPair> pairs, std::span<const double
   return std::sqrt(rss / dof / eig.eigenvalues()(first));
 }
 
-/// Unit common rotation axis of the A's: their rotation vectors sign-aligned with the largest, summed.
-Vec3 common_rotation_axis(std::span<const MotionPair> pairs) {
-  Vec3 reference = Vec3::Zero();
-  for (const MotionPair& p : pairs) {
-    const Vec3 phi = so3_log(p.A.rotation());
-    if (phi.norm() > reference.norm()) reference = phi;
-  }
-  Vec3 sum = Vec3::Zero();
-  for (const MotionPair& p : pairs) {
-    const Vec3 phi = so3_log(p.A.rotation());
-    sum += phi.dot(reference) >= 0.0 ? phi : Vec3(-phi);
-  }
-  Vec3 axis = sum.norm() > 0.0 ? Vec3(sum.normalized()) : Vec3::UnitZ();
+/// The common rotation axis with its largest component positive (a stable sign for the report).
+Vec3 signed_common_axis(std::span<const MotionPair> pairs) {
+  const Vec3 axis = common_rotation_axis(pairs);
   Eigen::Index largest = 0;
   axis.cwiseAbs().maxCoeff(&largest);
   return axis(largest) < 0.0 ? Vec3(-axis) : axis;
@@ -217,7 +207,7 @@ void OnlineHandEye::solve_planar_rotation() {
     if (translation_valid_[k]) valid.push_back(pairs_[k]);
   }
   if (pairs_.size() < config_.planar_min_pairs || valid.size() < std::max<std::size_t>(3, config_.translation_min_pairs)) return;
-  const Vec3 axis = common_rotation_axis(valid);
+  const Vec3 axis = signed_common_axis(valid);
   const PlanarSolution planar = solve_planar(valid, axis);
   if (!(planar.condition >= config_.planar_min_condition)) return;
   const std::vector<double> ones(pairs_.size(), 1.0);
