@@ -17,7 +17,6 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <random>
 #include <stdexcept>
@@ -48,19 +47,7 @@ struct Options {
 fs::path data_dir() { return fs::path(MLIDAR_SHARED_DATA) / "real" / "opencalib_3lidar"; }
 
 std::map<int, fs::path> device_clouds(const std::string& scene) {
-  std::ifstream in(data_dir() / scene / "lidar_cloud_path.txt");
-  std::map<int, fs::path> clouds;
-  std::string key;
-  int id = -1;
-  while (in >> key) {
-    if (key == "device_id:") in >> id;
-    if (key == "path:") {
-      std::string path;
-      in >> path;
-      clouds[id] = data_dir() / scene / fs::path(path).filename();
-    }
-  }
-  return clouds;
+  return mlidar::io::read_opencalib_cloud_paths(data_dir() / scene / "lidar_cloud_path.txt");
 }
 
 mlidar::Scan scan_of(const fs::path& file) { return mlidar::io::to_scan(mlidar::io::read_cloud(file).table, file.string()); }

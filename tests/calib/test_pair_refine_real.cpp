@@ -8,7 +8,6 @@
 // per side here; every scene: bench/pair_refine_scenes perturbed=1).
 #include <algorithm>
 #include <array>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <string>
@@ -36,19 +35,7 @@ fs::path scene_dir(const std::string& scene) { return shared_data() / "real" / "
 
 /// device id -> cloud file, from lidar_cloud_path.txt ("device_id: N" then "path: data/SCENE/FILE").
 std::map<int, fs::path> device_clouds(const std::string& scene) {
-  std::ifstream in(scene_dir(scene) / "lidar_cloud_path.txt");
-  std::map<int, fs::path> clouds;
-  std::string key;
-  int id = -1;
-  while (in >> key) {
-    if (key == "device_id:") in >> id;
-    if (key == "path:") {
-      std::string path;
-      in >> path;
-      clouds[id] = scene_dir(scene) / fs::path(path).filename();
-    }
-  }
-  return clouds;
+  return io::read_opencalib_cloud_paths(scene_dir(scene) / "lidar_cloud_path.txt");
 }
 
 /// The device id whose cloud file name starts with `name` ("left", "right").

@@ -139,6 +139,18 @@ TEST(OpenCalibRealData, InitialExtrinsicsOfThreeScenes) {
   EXPECT_NEAR(perturbed.lidars[2].T_base_lidar.rotation_matrix()(2, 2), std::cos(3 * deg) * std::cos(54 * deg), 1e-12);
 }
 
+TEST(OpenCalibRealData, CloudPathsNameTheSceneClouds) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  const auto scene = test::shared_data() / "real/opencalib_3lidar/0002";
+  const auto clouds = read_opencalib_cloud_paths(scene / "lidar_cloud_path.txt");
+  ASSERT_EQ(clouds.size(), 3u);
+  for (const auto& [id, file] : clouds) {
+    EXPECT_EQ(file.parent_path(), scene) << id;
+    EXPECT_TRUE(std::filesystem::exists(file)) << file;
+  }
+  EXPECT_EQ(clouds.at(0).filename().string().rfind("top", 0), 0u) << clouds.at(0);  // device 0: the top LiDAR
+}
+
 TEST(OpenCalibRealData, P64ToQtJson) {
   MLIDAR_REQUIRE_SHARED_DATA();
   const Extrinsics e = read_opencalib_json(test::shared_data() / "real/opencalib_p64_qt/p64-to-qt-extrinsic.json");
@@ -163,6 +175,10 @@ TEST(OpenCalibRejects, TextAndJson) {
                      {"i.txt", "line 2", "6 numbers"});
   expect_input_error([] { parse_opencalib_json("{\"a\": {\"sensor_name\": \"x\"}}", "j.json"); }, {"j.json", "a.target_sensor_name", "missing"});
   expect_input_error([] { parse_opencalib_json("{\"a\": ", "j.json"); }, {"j.json", "not valid JSON"});
+  expect_input_error([] { parse_opencalib_cloud_paths("path: a.pcd\n", "p.txt", "."); }, {"p.txt", "line 1", "without a device_id"});
+  expect_input_error([] { parse_opencalib_cloud_paths("device_id: 0\npath: a.pcd\ndevice_id: 0\n", "p.txt", "."); },
+                     {"p.txt", "line 3", "appears twice"});
+  expect_input_error([] { parse_opencalib_cloud_paths("device_id: 1\n", "p.txt", "."); }, {"p.txt", "device_id 1", "no path line"});
 }
 
 }  // namespace

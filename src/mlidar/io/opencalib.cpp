@@ -38,6 +38,39 @@ std::string device_name(long long id, const std::vector<std::string>& names, con
 
 }  // namespace
 
+std::map<int, std::filesystem::path> parse_opencalib_cloud_paths(const std::string& text, const std::string& source,
+                                                                 const std::filesystem::path& directory) {
+  constexpr std::string_view kPathKey = "path:";
+  std::map<int, std::filesystem::path> clouds;
+  int id = -1;  // the device awaiting its path line, -1: none
+  for (const auto& line : split_lines(text)) {
+    const std::string_view content = trim(line.text);
+    if (content.empty()) continue;
+    const std::string field = line_field(line.number);
+    if (content.starts_with(kDeviceKey)) {
+      if (id >= 0) throw InputError(source, field, "device_id without a 'path:' line before it");
+      const long long value = parse_integer(trim(content.substr(kDeviceKey.size())), source, field + " (device_id)");
+      if (value < 0 || value > 1'000'000) throw InputError(source, field, "device_id must be in [0, 1000000]");
+      if (clouds.contains(static_cast<int>(value))) throw InputError(source, field, "device_id " + std::to_string(value) + " appears twice");
+      id = static_cast<int>(value);
+    } else if (content.starts_with(kPathKey)) {
+      if (id < 0) throw InputError(source, field, "path line without a device_id line before it");
+      const std::filesystem::path file = std::filesystem::path(std::string(trim(content.substr(kPathKey.size())))).filename();
+      if (file.empty()) throw InputError(source, field, "empty path");
+      clouds[id] = directory / file;
+      id = -1;
+    } else {
+      throw InputError(source, field, "expected 'device_id: N' or 'path: FILE'");
+    }
+  }
+  if (id >= 0) throw InputError(source, "device_id " + std::to_string(id), "has no path line");
+  return clouds;
+}
+
+std::map<int, std::filesystem::path> read_opencalib_cloud_paths(const std::filesystem::path& path) {
+  return parse_opencalib_cloud_paths(read_file_text(path), path.string(), path.parent_path());
+}
+
 Extrinsics parse_opencalib_initial_extrinsics(const std::string& text, const std::string& source,
                                               const std::vector<std::string>& names) {
   Extrinsics extrinsics;

@@ -2,6 +2,7 @@
 // Readers for the extrinsics files of OpenCalib (PJLab-ADG/SensorsCalibration),
 // returned as mlidar Extrinsics so they feed calibration and SLAM directly.
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,14 @@ namespace mlidar::io {
 Extrinsics parse_opencalib_initial_extrinsics(const std::string& text, const std::string& source,
                                               const std::vector<std::string>& names = {});
 Extrinsics read_opencalib_initial_extrinsics(const std::filesystem::path& path, const std::vector<std::string>& names = {});
+
+/// lidar2lidar `lidar_cloud_path.txt`: `device_id: N` then `path: P` per
+/// device; P's file name is taken in `directory` (the paths name OpenCalib's
+/// own layout). Returns device id -> cloud file.
+std::map<int, std::filesystem::path> parse_opencalib_cloud_paths(const std::string& text, const std::string& source,
+                                                                 const std::filesystem::path& directory);
+/// The file in a scene folder; the clouds are looked up beside it.
+std::map<int, std::filesystem::path> read_opencalib_cloud_paths(const std::filesystem::path& path);
 
 /// OpenCalib JSON (`*-extrinsic.json`): top-level entries holding
 /// `sensor_name`, `target_sensor_name` and `param.sensor_calib.data` (4x4,
