@@ -147,15 +147,20 @@ void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std
   out.role = track.role;
 }
 
-void SlamEstimator::make_untrusted(std::size_t j) {
+void SlamEstimator::restart_initialization(std::size_t j) {
   Track& track = *tracks_[j];
   track.role = LidarRole::initializing;
   track.hand_eye.reset();
   track.rotation_only_pairs = 0;
   monitor_.restart(j);
+  track.recent.clear();
+}
+
+void SlamEstimator::make_untrusted(std::size_t j) {
+  restart_initialization(j);
+  Track& track = *tracks_[j];
   track.T_g_lidar = SE3(track.setup.T_base_lidar.rotation(), Vec3::Zero());
   track.own.reset();  // restarted at its next scan, with up from that scan's ground (restart_own_odometry)
-  track.recent.clear();
   track.report.covariance.reset();
   track.report.covariance_parts.reset();
   ++track.report.restarts;

@@ -147,6 +147,8 @@ class SlamEstimator {
   void check_reinitialization(std::size_t frame_index, SlamFrame& out);
   void calibrate(std::size_t j, double stamp, const Scan& scan, std::size_t frame_index, SlamLidarFrame& out);
   void detect_shocks(std::size_t frame_index, SlamFrame& out);
+  /// Back to initialization: hand-eye, pair history and Algorithm 1 restarted (shock and re-initialization share it).
+  void restart_initialization(std::size_t j);
   void make_untrusted(std::size_t j);
   /// A new own odometry for initializing LiDAR j, its up from `scan`'s ground near the old one.
   void restart_own_odometry(std::size_t j, const Scan& scan);

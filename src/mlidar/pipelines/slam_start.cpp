@@ -102,12 +102,8 @@ void SlamEstimator::check_reinitialization(std::size_t frame_index, SlamFrame& o
     if (params.reinitialize_windows == 0 || track.role != LidarRole::calibrating || l.accepted || l.mean_residual_m < 0.0 || !(base_residual > 0.0)) continue;
     if (l.mean_residual_m > params.reinitialize_residual_ratio * base_residual) ++track.high_residual_windows;
     if (track.high_residual_windows < params.reinitialize_windows) continue;
-    track.role = LidarRole::initializing;
-    track.hand_eye.reset();
-    track.rotation_only_pairs = 0;
-    monitor_.restart(j);
+    restart_initialization(j);
     track.own = std::make_unique<slam::Odometry>(config_.odometry, std::vector{with_extrinsic(track.setup, track.T_g_lidar)});
-    track.recent.clear();
     track.window.clear();
     track.pending.reset();
     track.report.reinitialization_frames.push_back(frame_index);
