@@ -179,6 +179,7 @@ TEST(OpenCalibRejects, TextAndJson) {
   expect_input_error([] { parse_opencalib_cloud_paths("device_id: 0\npath: a.pcd\ndevice_id: 0\n", "p.txt", "."); },
                      {"p.txt", "line 3", "appears twice"});
   expect_input_error([] { parse_opencalib_cloud_paths("device_id: 1\n", "p.txt", "."); }, {"p.txt", "device_id 1", "no path line"});
+  expect_input_error([] { parse_opencalib_cloud_paths("device_id: 0\npath: data/..\n", "p.txt", "."); }, {"p.txt", "line 2", "cloud file name"});
 }
 
 }  // namespace

@@ -56,7 +56,7 @@ std::map<int, std::filesystem::path> parse_opencalib_cloud_paths(const std::stri
     } else if (content.starts_with(kPathKey)) {
       if (id < 0) throw InputError(source, field, "path line without a device_id line before it");
       const std::filesystem::path file = std::filesystem::path(std::string(trim(content.substr(kPathKey.size())))).filename();
-      if (file.empty()) throw InputError(source, field, "empty path");
+      if (file.empty() || file == "." || file == "..") throw InputError(source, field, "the path must end in a cloud file name");
       clouds[id] = directory / file;
       id = -1;
     } else {
