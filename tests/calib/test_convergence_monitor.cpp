@@ -80,13 +80,19 @@ TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   EXPECT_GT(monitor.lidar(0).covariance.diagonal().minCoeff(), 0.25 * 0.01 * 0.01 / 25);
 }
 
+/// A monitor that needs 4 accepted windows, fed 4 identical ones (estimate kTruth, residual variance 1e-3).
+ConvergenceMonitor converged_on_identical_windows(ConvergenceConfig config, const Mat6& information) {
+  config.accepted_needed = 4;
+  ConvergenceMonitor monitor({kTruth}, config);
+  for (int window = 0; window < 4; ++window) monitor.add_window(0, kTruth, information, 1e-3);
+  return monitor;
+}
+
 TEST(ConvergenceMonitor, WindowCovariancesEnterXiCalibWhenTheResidualVarianceIsGiven) {
   ConvergenceConfig config;
-  config.accepted_needed = 4;
   config.min_autocorrelation_time = 5.0;
-  ConvergenceMonitor monitor({kTruth}, config);
   const Mat6 information = information_with_min(100.0, 2);
-  for (int window = 0; window < 4; ++window) monitor.add_window(0, kTruth, information, 1e-3);
+  const ConvergenceMonitor monitor = converged_on_identical_windows(config, information);
   ASSERT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
   // Identical estimates: no scatter; Xi_calib is one window's sigma^2 Lambda^-1 in the local tangent.
   const Mat6 expected = local_covariance_from_left_information(kTruth, information, 1e-3);
@@ -97,12 +103,9 @@ TEST(ConvergenceMonitor, WindowCovariancesEnterXiCalibWhenTheResidualVarianceIsG
 
 TEST(ConvergenceMonitor, SharedErrorFloorIsAddedPerAxis) {
   ConvergenceConfig config;
-  config.accepted_needed = 4;
   config.bias_translation_sd_m = 0.015;
   config.bias_rotation_sd_deg = 0.1;
-  ConvergenceMonitor monitor({kTruth}, config);
-  const Mat6 information = information_with_min(100.0, 3);
-  for (int window = 0; window < 4; ++window) monitor.add_window(0, kTruth, information, 1e-3);
+  const ConvergenceMonitor monitor = converged_on_identical_windows(config, information_with_min(100.0, 3));
   ASSERT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
   const CalibrationCovariance& parts = monitor.lidar(0).covariance_parts;
   Vec6 variance;
