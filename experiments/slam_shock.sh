@@ -7,15 +7,19 @@
 # it, re-initialize the LiDAR and re-converge to the new extrinsic. Prints the
 # right LiDAR's role changes, its shock frames and its error against the
 # extrinsic after the shock (and against the one before, for contrast).
-#   experiments/slam_shock.sh BUILD_DIR SCENE FRAMES SHOCK SEED WORK_DIR
+# SHIFT (optional) sets another shock as "tx ty tz rx ry rz" (m, deg); CONFIG
+# (optional) is passed to `mlidar slam --config`.
+#   experiments/slam_shock.sh BUILD_DIR SCENE FRAMES SHOCK SEED WORK_DIR [SHIFT [CONFIG]]
 set -euo pipefail
 build=${1:?BUILD_DIR}; scene=${2:?SCENE}; frames=${3:?FRAMES}; shock=${4:?SHOCK}; seed=${5:?SEED}; work=${6:?WORK_DIR}
+read -r -a shift_values <<< "${7:-0.1 0.1 0.1 10 10 10}"
+config_args=(); [[ -n "${8:-}" ]] && config_args=(--config "$8")
 mlidar="$build/apps/mlidar/mlidar"
 here=$(cd "$(dirname "$0")" && pwd)
 sim="$work/$scene-$seed"; run="$work/run-$scene-$seed"
 rm -rf "$sim" "$run"; mkdir -p "$work"
 "$mlidar" simulate drive --rig rhd --scene "$scene" --trajectory handheld --frames "$frames" --seed "$seed" --perturb 0,0 --out "$sim" > /dev/null
-read -r qw qx qy qz tx ty tz < <(python3 "$here/shift_mounting.py" "$sim/scans/right" "$shock" 0.1 0.1 0.1 10 10 10)
+read -r qw qx qy qz tx ty tz < <(python3 "$here/shift_mounting.py" "$sim/scans/right" "$shock" "${shift_values[@]}")
 # The extrinsic after the shock: T_base_right Delta.
 python3 - "$sim/groundtruth/extrinsics.yaml" "$work/after.yaml" "$qw" "$qx" "$qy" "$qz" "$tx" "$ty" "$tz" <<'PY'
 import re, sys
@@ -33,7 +37,7 @@ q_new = [a[0]*b[0]-a[1]*b[1]-a[2]*b[2]-a[3]*b[3], a[0]*b[1]+a[1]*b[0]+a[2]*b[3]-
 fmt = lambda v: "[" + ", ".join(f"{c:.12g}" for c in v) + "]"
 open(sys.argv[2], "w").write(head + f"  right:\n    translation: {fmt(t_new)}\n    quaternion_wxyz: {fmt(q_new)}\n")
 PY
-code=0; "$mlidar" slam --dataset "$sim" --out "$run" > "$run.log" 2>&1 || code=$?
+code=0; "$mlidar" slam --dataset "$sim" "${config_args[@]}" --out "$run" > "$run.log" 2>&1 || code=$?
 echo "exit $code; shock at frame $shock of $frames"
 jq -r '[.per_frame | to_entries[] | {k: .key, r: .value.lidars.right.role}] | . as $f
   | [range(1; length) | select($f[.].r != $f[. - 1].r) | "\($f[.].k): \($f[. - 1].r) -> \($f[.].r)"] | join(", ")
