@@ -50,6 +50,19 @@ TEST(ConvergenceMonitor, AcceptsJustAboveAndRejectsJustBelowLambdaCalib) {
   EXPECT_EQ(monitor.lidar(1).windows, 2u);
 }
 
+TEST(ConvergenceMonitor, AConstrainedWindowThatHasNotSettledIsNotAccepted) {
+  ConvergenceMonitor monitor({kTruth});
+  const Mat6 information = information_with_min(100.0, 4);
+  const WindowVerdict moving = monitor.add_window(0, kTruth, information, 1e-3, false);
+  EXPECT_TRUE(moving.constrained);
+  EXPECT_FALSE(moving.accepted);
+  EXPECT_TRUE(monitor.lidar(0).accepted.empty());
+  const WindowVerdict settled = monitor.add_window(0, kTruth, information, 1e-3, true);
+  EXPECT_TRUE(settled.constrained && settled.accepted);
+  EXPECT_EQ(monitor.lidar(0).accepted.size(), 1u);
+  EXPECT_FALSE(monitor.add_window(0, kTruth, information_with_min(40.0, 5), 1e-3, true).constrained);
+}
+
 TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   ConvergenceMonitor monitor({kTruth});
   std::mt19937_64 rng(3);

@@ -53,16 +53,32 @@ TEST(CalibrationWindow, RecoversTheExtrinsicWithoutNoise) {
   Vec6 error;
   error << 0.03, -0.02, 0.01, 0.01, -0.01, 0.012;
   const SE3 start = SE3::exp(error) * T_true;
-  const std::array<double, 2> gates = {0.5, 0.1};
-  const CalibrationWindowResult result = solve_calibration_window(frames, start, map, gates, 0.1);
+  CalibrationWindowOptions options;
+  options.gates_m = {0.5, 0.1};
+  const CalibrationWindowResult result = solve_calibration_window(frames, start, map, options);
   ASSERT_TRUE(result.solved);
   EXPECT_LT((result.T_base_lidar.inverse() * T_true).log().norm(), 1e-4);
   EXPECT_LT(result.fit.mean_residual_m(), 1e-3);
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6>(result.information).eigenvalues()(0), 1.0);
+  // Settled: the last pass at the last gate moved it less than the tolerances, within the pass budget.
+  EXPECT_TRUE(result.settled);
+  EXPECT_LE(result.last_step_m, options.settle_translation_m);
+  EXPECT_LE(result.last_step_rad, options.settle_rotation_rad);
+  EXPECT_GE(result.passes, 2);
+  EXPECT_LE(result.passes, 2 + options.settle_passes);
+  // Without extra passes exactly the two gates run; the start 3 cm off needs more than one to settle.
+  CalibrationWindowOptions gates_only = options;
+  gates_only.settle_passes = 0;
+  EXPECT_EQ(solve_calibration_window(frames, start, map, gates_only).passes, 2);
+  CalibrationWindowOptions one_gate = gates_only;
+  one_gate.gates_m = {0.1};
+  const CalibrationWindowResult one_pass = solve_calibration_window(frames, start, map, one_gate);
+  EXPECT_EQ(one_pass.passes, 1);
+  EXPECT_FALSE(one_pass.settled);
 
   std::vector<CalibrationFrame> empty(frames.size());
   for (std::size_t i = 0; i < frames.size(); ++i) empty[i].T_world_base = frames[i].T_world_base;
-  const CalibrationWindowResult none = solve_calibration_window(empty, start, map, gates, 0.1);
+  const CalibrationWindowResult none = solve_calibration_window(empty, start, map, options);
   EXPECT_FALSE(none.solved);
   EXPECT_LT((none.T_base_lidar.inverse() * start).log().norm(), 1e-12);
 }

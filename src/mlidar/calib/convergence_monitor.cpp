@@ -112,7 +112,8 @@ ConvergenceMonitor::ConvergenceMonitor(std::vector<SE3> initial, ConvergenceConf
   }
 }
 
-WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information, double residual_variance) {
+WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information, double residual_variance,
+                                             bool settled) {
   LidarCalibrationState& state = lidars_.at(lidar);
   WindowVerdict verdict;
   if (state.mode == CalibrationMode::converged) return verdict;  // line 2: calibration has stopped
@@ -127,7 +128,8 @@ WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_bas
                                                            Eigen::EigenvaluesOnly)
                            .eigenvalues()(0);
   state.last_lambda_min = verdict.lambda_min;
-  if (!(verdict.lambda_min > config_.lambda_calib)) return verdict;
+  verdict.constrained = verdict.lambda_min > config_.lambda_calib;
+  if (!verdict.constrained || !settled) return verdict;
   // Lines 5-7: accept.
   verdict.accepted = true;
   state.T_base_lidar = T_base_lidar;

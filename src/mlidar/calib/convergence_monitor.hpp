@@ -72,7 +72,8 @@ std::string_view to_string(CalibrationMode mode);
 
 struct WindowVerdict {
   double lambda_min = 0.0;
-  bool accepted = false;          ///< lambda_min > lambda_calib (line 5)
+  bool constrained = false;       ///< lambda_min > lambda_calib (line 5)
+  bool accepted = false;          ///< constrained and settled: the estimate joins L (lines 6-7)
   bool converged_now = false;     ///< this window completed L_calib (lines 8-11)
 };
 
@@ -101,7 +102,10 @@ class ConvergenceMonitor {
   /// A non-finite estimate or information is never accepted.
   /// `residual_variance` (> 0: the window's sigma^2 per residual row) makes the
   /// window's own covariance sigma^2 information^-1 part of Xi_calib; 0: unknown.
-  WindowVerdict add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information, double residual_variance = 0.0);
+  /// `settled` false (the window's re-matching was still moving its estimate)
+  /// keeps a constrained window out of L: a transient would bias the mean.
+  WindowVerdict add_window(std::size_t lidar, const SE3& T_base_lidar, const Mat6& information, double residual_variance = 0.0,
+                           bool settled = true);
 
   /// Back to calibrating from the current extrinsic, L emptied (the re-calibration trigger).
   void restart(std::size_t lidar);

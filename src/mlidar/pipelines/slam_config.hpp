@@ -25,6 +25,8 @@ struct WindowParams {
   double extrinsic_covariance_scale = 1.0;  ///< alpha >= 1: scale of the extrinsic covariance (10 under large perturbation)
   /// Refine the trusted odometry's poses in the sliding window (eq 4.22, slam_pose_window.hpp).
   bool refine_odometry = false;
+  /// Extra re-matching passes of a calibration window at its last gate until the estimate settles (calibration_window.hpp).
+  int calibration_settle_passes = 4;
 };
 
 /// How a LiDAR's calibration starts and starts again (beyond the thesis).

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "mlidar/calib/ground_up.hpp"
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/pipelines/slam_track.hpp"
 #include "mlidar/slam/calibration_window.hpp"
 
@@ -16,11 +17,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-/// Correspondence gates (m) of the calibration's re-matching passes: the
-/// hand-eye start may be a degree and centimetres off (0.5 m at 30 m range),
-/// the second pass matches at the first pass's solution.
-constexpr std::array<double, 2> kCalibrationGatesM = {1.0, 0.3};
 
 /// The trusted LiDARs' scans at `stamp`; a missing one is an empty scan (it contributes no features).
 Frame trusted_frame(double stamp, const std::vector<std::optional<Scan>>& scans, const std::vector<std::size_t>& trusted) {
@@ -118,18 +114,25 @@ void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std
 
   // Eq 4.21: the window's poses are fixed by the map; T_base_lidar_j is the variable.
   const slam::MapView map{odometry_->edge_map(), odometry_->plane_map(), config_.odometry.registration};
-  const slam::CalibrationWindowResult window =
-      slam::solve_calibration_window(track.window, track.setup.T_base_lidar, map, kCalibrationGatesM, config_.odometry.registration.huber_delta_m);
+  slam::CalibrationWindowOptions options;
+  options.huber_delta_m = config_.odometry.registration.huber_delta_m;
+  options.settle_passes = config_.window.calibration_settle_passes;
+  const slam::CalibrationWindowResult window = slam::solve_calibration_window(track.window, track.setup.T_base_lidar, map, options);
   if (!window.solved) return;
   out.mean_residual_m = window.fit.mean_residual_m();
-  const calib::WindowVerdict verdict = monitor_.add_window(j, window.T_base_lidar, window.information, window.residual_variance_m2);
+  const calib::WindowVerdict verdict =
+      monitor_.add_window(j, window.T_base_lidar, window.information, window.residual_variance_m2, window.settled);
   out.lambda_min = verdict.lambda_min;
   out.window_estimate = window.T_base_lidar;
   out.window_information = window.information;
   out.window_residual_variance_m2 = window.residual_variance_m2;
+  out.window_step_m = window.last_step_m;
+  out.window_step_deg = rad_to_deg(window.last_step_rad);
+  out.window_settled = window.settled;
   out.accepted = verdict.accepted;
   track.report.weak = monitor_.lidar(j).weak;
-  if (verdict.accepted) track.setup.T_base_lidar = window.T_base_lidar;
+  // A constrained window that had not settled still moves the next window's start (it would otherwise restart from here).
+  if (verdict.constrained) track.setup.T_base_lidar = window.T_base_lidar;
   if (verdict.accepted) track.high_residual_windows = 0;
   track.report.accepted = monitor_.lidar(j).accepted.size();
   if (!verdict.converged_now) return;

@@ -79,6 +79,9 @@ struct SlamLidarFrame {
   std::optional<SE3> window_estimate;  ///< T_base_lidar of this frame's window (accepted or not)
   std::optional<Mat6> window_information;  ///< its extrinsic information ([t, r], left perturbation, 1/m^2)
   double window_residual_variance_m2 = -1.0;  ///< its residual variance per row (-1: no window)
+  double window_step_m = -1.0;     ///< its estimate's change in the last re-matching pass, translation (-1: no window)
+  double window_step_deg = -1.0;   ///< ... and rotation
+  bool window_settled = false;     ///< that change was within the settle tolerances (else not accepted)
   double mean_residual_m = -1.0;   ///< against the map (-1: none)
   bool shock = false;              ///< the re-calibration trigger fired
   bool reinitialized = false;      ///< sent back to initialization (window residuals high, none accepted)

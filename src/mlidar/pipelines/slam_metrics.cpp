@@ -40,6 +40,8 @@ nlohmann::json lidar_frame_json(const SlamLidarFrame& l) {
           {"window_information", l.window_information ? nlohmann::json(std::vector<double>(l.window_information->data(), l.window_information->data() + 36))
                                                       : nlohmann::json(nullptr)},
           {"window_residual_variance_m2", number_or_null(l.window_residual_variance_m2)},
+          {"window_step_m", number_or_null(l.window_step_m)}, {"window_step_deg", number_or_null(l.window_step_deg)},
+          {"window_settled", l.window_settled},
           {"reinitialized", l.reinitialized}};
 }
 
