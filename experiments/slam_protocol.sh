@@ -11,9 +11,11 @@
 # ground-truth trajectory and the first convergence's time (s after the first
 # frame; the converged frame column is the last convergence, later after a
 # shock trigger).
-#   experiments/slam_protocol.sh BUILD_DIR SCENE FRAMES SEEDS WORK_DIR
+# CONFIG (optional) is passed to `mlidar slam --config`.
+#   experiments/slam_protocol.sh BUILD_DIR SCENE FRAMES SEEDS WORK_DIR [CONFIG]
 set -euo pipefail
 build=${1:?BUILD_DIR}; scene=${2:?SCENE}; frames=${3:?FRAMES}; seeds=${4:?SEEDS}; work=${5:?WORK_DIR}
+config_args=(); [[ -n "${6:-}" ]] && config_args=(--config "$6")
 mlidar="$build/apps/mlidar/mlidar"
 mkdir -p "$work"
 rig="$work/rhd_sigma005.yaml"
@@ -39,7 +41,7 @@ for seed in $(seq 1 "$seeds"); do
   sim="$work/$scene-$seed"; run="$work/run-$scene-$seed"
   rm -rf "$sim" "$run"
   "$mlidar" simulate drive --rig "$rig" --scene "$scene" --trajectory handheld --frames "$frames" --seed "$seed" --perturb 5,0.1 --out "$sim" > /dev/null
-  code=0; "$mlidar" slam --dataset "$sim" --out "$run" > /dev/null 2>&1 || code=$?
+  code=0; "$mlidar" slam --dataset "$sim" "${config_args[@]}" --out "$run" > /dev/null 2>&1 || code=$?
   "$mlidar" eval traj --gt "$sim/groundtruth/trajectory.tum" --est "$run/trajectory.tum" --json "$run/traj.json" > /dev/null
   "$mlidar" eval calib --gt "$sim/groundtruth/extrinsics.yaml" --est "$run/extrinsics.yaml" --json "$run/calib.json" > /dev/null || true
   ate=$(jq '.ate.translation_m.rmse' "$run/traj.json")

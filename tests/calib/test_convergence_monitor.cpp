@@ -63,6 +63,46 @@ TEST(ConvergenceMonitor, AConstrainedWindowThatHasNotSettledIsNotAccepted) {
   EXPECT_FALSE(monitor.add_window(0, kTruth, information_with_min(40.0, 5), 1e-3, true).constrained);
 }
 
+TEST(RobustInliers, DropsTheFarEstimatesAndKeepsAgreeingOnes) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  std::vector<Vec6> deviations;
+  for (int i = 0; i < 20; ++i) deviations.push_back((Vec6() << noise(rng), noise(rng), noise(rng), 0, 0, 0).finished());
+  for (int i = 0; i < 5; ++i) deviations.push_back((Vec6() << 0, 0.06 + 0.02 * i, 0, 0, 0, 0).finished());
+  const Vec6 floor = Vec6::Constant(0.001);
+  const std::vector<std::size_t> inliers = robust_inliers(deviations, 3.0, floor);
+  // Every far one goes; a 3-sigma gate on three noisy axes may also drop a tail sample or two of the 20.
+  EXPECT_GE(inliers.size(), 18u);
+  for (const std::size_t i : inliers) EXPECT_LT(i, 20u);
+  EXPECT_EQ(robust_inliers(deviations, 0.0, floor).size(), 25u);  // off
+  // Identical estimates (MAD 0): the floor keeps every one.
+  const std::vector<Vec6> identical(10, Vec6::Constant(0.01));
+  EXPECT_EQ(robust_inliers(identical, 3.0, floor).size(), 10u);
+}
+
+TEST(ConvergenceMonitor, OutlyingAcceptedEstimatesAreLeftOutOfTheMean) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  const auto run = [&](double outlier_mads) {
+    ConvergenceConfig config;
+    config.outlier_mads = outlier_mads;
+    ConvergenceMonitor monitor({kTruth}, config);
+    rng.seed(11);
+    for (int i = 0; i < 25; ++i) {
+      const Vec3 t_error = i < 19 ? Vec3(noise(rng), noise(rng), noise(rng)) : Vec3(0.0, 0.1, 0.0);  // 6 windows 10 cm off in y
+      monitor.add_window(0, SE3(kTruth.rotation(), kTruth.translation() + t_error), information_with_min(100.0, 40 + i));
+    }
+    EXPECT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
+    return monitor.lidar(0);
+  };
+  const LidarCalibrationState plain = run(0.0);
+  EXPECT_EQ(plain.outliers, 0u);
+  EXPECT_GT((plain.T_base_lidar.translation() - kTruth.translation()).norm(), 0.02);  // 6 / 25 of 10 cm
+  const LidarCalibrationState robust = run(3.0);
+  EXPECT_EQ(robust.outliers, 6u);
+  EXPECT_LT((robust.T_base_lidar.translation() - kTruth.translation()).norm(), 0.004);
+}
+
 TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   ConvergenceMonitor monitor({kTruth});
   std::mt19937_64 rng(3);

@@ -35,6 +35,18 @@ Quat karcher_mean(std::span<const Quat> rotations) {
 
 bool finite(const SE3& T) { return T.rotation().coeffs().allFinite() && T.translation().allFinite(); }
 
+double median(std::vector<double> values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  if (values.size() % 2 == 1) return *middle;
+  return 0.5 * (*middle + *std::max_element(values.begin(), middle));
+}
+
+constexpr double kMadToSigma = 1.4826;  ///< MAD of a normal distribution times this is its sigma
+/// Robust sigma floor of the accepted estimates, [t m, r rad]: agreeing windows are never trimmed for mm scatter.
+Vec6 robust_sigma_floor() { return (Vec6() << Vec3::Constant(0.002), Vec3::Constant(deg_to_rad(0.02))).finished(); }
+
+
 }  // namespace
 
 std::string describe_direction(const Vec6& direction) {
@@ -93,6 +105,22 @@ ExtrinsicMean extrinsic_mean(std::span<const SE3> samples) {
   return result;
 }
 
+std::vector<std::size_t> robust_inliers(std::span<const Vec6> deviations, double max_mads, const Vec6& sigma_floor) {
+  std::vector<std::size_t> inliers(deviations.size());
+  std::iota(inliers.begin(), inliers.end(), std::size_t{0});
+  if (!(max_mads > 0.0) || deviations.empty()) return inliers;
+  Vec6 centre, bound;
+  for (int axis = 0; axis < 6; ++axis) {
+    std::vector<double> values;
+    for (const Vec6& d : deviations) values.push_back(d(axis));
+    centre(axis) = median(values);
+    for (double& v : values) v = std::abs(v - centre(axis));
+    bound(axis) = max_mads * std::max(kMadToSigma * median(values), sigma_floor(axis));
+  }
+  std::erase_if(inliers, [&](std::size_t i) { return ((deviations[i] - centre).cwiseAbs().array() > bound.array()).any(); });
+  return inliers;
+}
+
 std::string_view to_string(CalibrationMode mode) {
   switch (mode) {
     case CalibrationMode::calibrating: return "calibrating";
@@ -137,11 +165,25 @@ WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_bas
   if (residual_variance > 0.0 && std::isfinite(residual_variance))
     state.accepted_covariances.push_back(local_covariance_from_left_information(T_base_lidar, information, residual_variance));
   if (state.accepted.size() < config_.accepted_needed) return verdict;
-  // Lines 8-11: mean, covariance, stop. The windows' term only when every accepted window gave one.
-  const ExtrinsicMean mean = extrinsic_mean(state.accepted);
-  state.T_base_lidar = mean.mean;
+  // Lines 8-11: mean, covariance, stop, over the estimates that agree with the
+  // median (when they are at least half). The windows' term only when every accepted window gave one.
   const bool all_windows = state.accepted_covariances.size() == state.accepted.size();
-  state.covariance_parts = calibration_covariance(mean.local_deviations, all_windows ? std::span<const Mat6>(state.accepted_covariances) : std::span<const Mat6>(),
+  std::vector<SE3> kept = state.accepted;
+  std::vector<Mat6> kept_covariances = all_windows ? state.accepted_covariances : std::vector<Mat6>{};
+  const std::vector<std::size_t> inliers =
+      robust_inliers(extrinsic_mean(state.accepted).local_deviations, config_.outlier_mads, robust_sigma_floor());
+  if (inliers.size() < state.accepted.size() && 2 * inliers.size() >= state.accepted.size()) {
+    kept.clear();
+    kept_covariances.clear();
+    for (const std::size_t i : inliers) {
+      kept.push_back(state.accepted[i]);
+      if (all_windows) kept_covariances.push_back(state.accepted_covariances[i]);
+    }
+    state.outliers = state.accepted.size() - inliers.size();
+  }
+  const ExtrinsicMean mean = extrinsic_mean(kept);
+  state.T_base_lidar = mean.mean;
+  state.covariance_parts = calibration_covariance(mean.local_deviations, all_windows ? std::span<const Mat6>(kept_covariances) : std::span<const Mat6>(),
                                                   config_.min_autocorrelation_time);
   Vec6 bias_sd;
   bias_sd << Vec3::Constant(config_.bias_translation_sd_m), Vec3::Constant(deg_to_rad(config_.bias_rotation_sd_deg));
@@ -161,6 +203,7 @@ void ConvergenceMonitor::restart(std::size_t lidar) {
   state.covariance = Mat6::Zero();
   state.covariance_parts = {};
   state.weak.clear();
+  state.outliers = 0;
   ++state.restarts;
 }
 

@@ -11,7 +11,8 @@
 // sigma^2 Lambda^-1 (when the caller gives the residual variance), in the
 // tangent of extrinsics.yaml: [t additive, r local].
 // (The thesis tests |L| > L_calib; here exactly L_calib accepted estimates
-// converge, so `accepted_needed` is the sample size.) The eigenvectors of
+// converge, so `accepted_needed` is the sample size; with `outlier_mads` the
+// mean and Xi_calib are of the estimates that agree with the median.) The eigenvectors of
 // Lambda below lambda_calib are reported in words: the directions the motion
 // and scene left unobservable (e.g. "translation z" under planar motion).
 // Tangent order [t, r] as everywhere in mlidar; the names refer to the axes of
@@ -39,6 +40,10 @@ struct ConvergenceConfig {
   /// windows can see it. 0: none.
   double bias_translation_sd_m = 0.0;
   double bias_rotation_sd_deg = 0.0;
+  /// At convergence, accepted estimates farther than this many robust sigmas
+  /// (1.4826 MAD, floored at 2 mm / 0.02 deg) from the per-axis median are left
+  /// out of the mean and Xi_calib (a region of weak, biased windows); 0: none.
+  double outlier_mads = 0.0;
 };
 
 /// One eigen-direction of an information matrix.
@@ -67,6 +72,11 @@ struct ExtrinsicMean {
 /// Throws std::invalid_argument for an empty set.
 ExtrinsicMean extrinsic_mean(std::span<const SE3> samples);
 
+/// Indices of the `deviations` ([t, r] tangent vectors) within `max_mads`
+/// robust sigmas of the per-axis median on every axis; the robust sigma is
+/// 1.4826 MAD, at least `sigma_floor` per axis. All of them when max_mads <= 0.
+std::vector<std::size_t> robust_inliers(std::span<const Vec6> deviations, double max_mads, const Vec6& sigma_floor);
+
 enum class CalibrationMode { calibrating, converged };
 std::string_view to_string(CalibrationMode mode);
 
@@ -89,6 +99,7 @@ struct LidarCalibrationState {
   std::size_t windows = 0;              ///< windows seen while calibrating
   std::size_t restarts = 0;             ///< restart() calls (re-calibrations)
   std::vector<WeakDirection> weak;      ///< of the last window's information below lambda_calib
+  std::size_t outliers = 0;             ///< accepted estimates left out of the mean at convergence
 };
 
 class ConvergenceMonitor {

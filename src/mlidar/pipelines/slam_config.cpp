@@ -75,6 +75,8 @@ std::vector<Field> fields(SlamConfig& c) {
        &c.convergence.bias_translation_sd_m},
       {"convergence", "bias_rotation_sd_deg", {0.0, 180.0}, "per-axis 1-sigma (deg) of the error all windows share, added to Xi_calib",
        &c.convergence.bias_rotation_sd_deg},
+      {"convergence", "outlier_mads", {0.0, 100.0}, "accepted estimates beyond this many robust sigmas of the median are left out of the mean (0: none)",
+       &c.convergence.outlier_mads},
       {"window", "size", {1, 100}, "N: the window holds N + 1 states", &c.window.size},
       {"window", "pivot", {1, 100}, "p: pivot state, origin of the local map (<= size)", &c.window.pivot},
       {"window", "uncertainty_threshold", kPositive, "w: threshold for filtering uncertain points in mapping",

@@ -43,7 +43,7 @@ struct SlamConfig {
   calib::OnlineHandEyeConfig initialization{.translation_max_std_m = 0.1, .planar_rotation = true, .planar_min_pairs = 30};
   StartParams start;
   /// Algorithm 1; the shared-error floor measured on the simulated protocol (docs/benchmarks.md "Extrinsic covariance").
-  calib::ConvergenceConfig convergence{.bias_translation_sd_m = 0.01, .bias_rotation_sd_deg = 0.04};
+  calib::ConvergenceConfig convergence{.bias_translation_sd_m = 0.01, .bias_rotation_sd_deg = 0.04, .outlier_mads = 3.0};
   WindowParams window;
   /// Re-calibration trigger; a rise below 2x is not a shock: a sustained 1.45-1.76x rise of one LiDAR's residual
   /// ratio in part of the simulated room fired a false trigger (43 m protocol, room seed 6), Table 4.6's shock is 6x.

@@ -140,6 +140,7 @@ void SlamEstimator::calibrate(std::size_t j, double stamp, const Scan& scan, std
   track.setup.T_base_lidar = monitor_.lidar(j).T_base_lidar;
   track.report.covariance = config_.window.extrinsic_covariance_scale * monitor_.lidar(j).covariance;
   track.report.covariance_parts = monitor_.lidar(j).covariance_parts;
+  track.report.outliers = monitor_.lidar(j).outliers;
   track.report.converged_frame = frame_index;
   if (!track.report.first_converged_frame) track.report.first_converged_frame = frame_index;
   track.role = LidarRole::trusted;

@@ -110,6 +110,7 @@ struct SlamLidarReport {
   std::optional<std::size_t> converged_frame;    ///< last convergence
   std::optional<std::size_t> first_converged_frame;  ///< first convergence (earlier than the last after a shock trigger)
   std::size_t accepted = 0;            ///< accepted windows since the last (re)start
+  std::size_t outliers = 0;            ///< of those, left out of the mean at convergence (convergence.outlier_mads)
   std::size_t restarts = 0;            ///< shock-triggered re-calibrations
   std::vector<std::size_t> shock_frames;
   std::size_t missing_frames = 0;

@@ -88,6 +88,7 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
           {"converged_frame", optional_json(l.converged_frame)},
           {"first_converged_frame", optional_json(l.first_converged_frame)},
           {"accepted", l.accepted},
+          {"outlier_windows", l.outliers},
           {"restarts", l.restarts},
           {"shock_frames", l.shock_frames},
           {"reinitialization_frames", l.reinitialization_frames},

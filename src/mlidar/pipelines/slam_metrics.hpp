@@ -13,7 +13,7 @@
 //   per_lidar: {NAME: {role, translation, quaternion_wxyz, covariance (36 or null),
 //               initialization: {state, frame (null), pairs_stored, pairs_seen, singular_values,
 //                                translation_eigenvalues, rotation_rms_rad, planar_motion, unobservable_axis_base},
-//               converged_frame (null), first_converged_frame (null), accepted, restarts, shock_frames, missing_frames,
+//               converged_frame (null), first_converged_frame (null), accepted, outlier_windows, restarts, shock_frames, missing_frames,
 //               weak_directions: [{description, eigenvalue}]}}
 #include <string>
 #include <vector>
