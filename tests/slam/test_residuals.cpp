@@ -39,6 +39,23 @@ TEST(Residuals, PlaneJacobianMatchesNumeric) {
   }
 }
 
+TEST(Residuals, PlaneRowGivesTheVectorResidualsNormalEquations) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const PlaneCoefficients plane{Vec3(n(rng), n(rng), n(rng)).normalized(), n(rng) * 5.0};
+    const Vec3 q = Vec3(n(rng), n(rng), n(rng)) * 20.0;
+    Vec3 r;
+    Mat36 J;
+    plane_residual(plane, q, r, J);
+    const PlaneRow row = plane_row(plane, q);
+    EXPECT_NEAR(std::abs(row.residual), r.norm(), 1e-12);
+    const Mat6 H_vector = J.transpose() * J, H_row = row.jacobian * row.jacobian.transpose();
+    EXPECT_LT((H_vector - H_row).norm(), 1e-10 * (1.0 + H_vector.norm())) << trial;
+    EXPECT_LT((J.transpose() * r - row.jacobian * row.residual).norm(), 1e-10 * (1.0 + (J.transpose() * r).norm())) << trial;
+  }
+}
+
 TEST(Residuals, EdgeResidualIsDistanceToLineAndJacobianMatches) {
   std::mt19937_64 rng(4);
   std::normal_distribution<double> n(0.0, 1.0);

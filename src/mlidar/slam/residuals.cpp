@@ -12,6 +12,14 @@ void plane_residual(const PlaneCoefficients& plane, const Vec3& q_world, Vec3& r
   jacobian.rightCols<3>() = -wwT * hat(q_world);
 }
 
+PlaneRow plane_row(const PlaneCoefficients& plane, const Vec3& q_world) {
+  const Vec3& w = plane.normal;
+  PlaneRow row;
+  row.residual = w.dot(q_world) + plane.offset;
+  row.jacobian << w, q_world.cross(w);
+  return row;
+}
+
 EdgePlanes edge_planes(const Vec3& point, const Vec3& direction, const Vec3& q_world) {
   const Vec3 u = direction.normalized();
   const Vec3 offset = q_world - point;

@@ -27,6 +27,16 @@ struct PlaneCoefficients {
 /// Eq 4.7: residual and its Jacobian for the world point q = T p.
 void plane_residual(const PlaneCoefficients& plane, const Vec3& q_world, Vec3& residual, Mat36& jacobian);
 
+/// Eq 4.7 as one scalar row: r_H = a w with |w| = 1 gives J_H = w j and
+/// r_H = w a, so J_H^T J_H = j^T j and J_H^T r_H = j^T a with
+/// a = w^T q + d and j = [w^T, (q x w)^T]: the same normal equations at a
+/// third of the cost (what scan-to-map registration accumulates).
+struct PlaneRow {
+  double residual = 0.0;       ///< a, signed distance
+  Vec6 jacobian = Vec6::Zero();  ///< j^T
+};
+PlaneRow plane_row(const PlaneCoefficients& plane, const Vec3& q_world);
+
 /// The two planes of eq 4.8 for a line through `point` along unit `direction`,
 /// seen from q_world. When q lies on the line, w1 is any unit normal to it.
 struct EdgePlanes {

@@ -1,5 +1,6 @@
 #include "mlidar/slam/scan_to_map.hpp"
 
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -22,11 +23,10 @@ struct NormalEquations {
   std::size_t planes = 0;
   std::size_t edges = 0;
 
-  template <int Rows>
-  void add(const Eigen::Matrix<double, Rows, 1>& r, const Eigen::Matrix<double, Rows, 6>& J, double w) {
-    H.noalias() += w * J.transpose() * J;
-    g.noalias() += w * J.transpose() * r;
-    residual_sum += r.norm();
+  /// One scalar row (plane_row), weight w.
+  void add(const PlaneRow& row, double w) {
+    H.noalias() += (w * row.jacobian) * row.jacobian.transpose();
+    g.noalias() += (w * row.residual) * row.jacobian;
   }
   NormalEquations& operator+=(const NormalEquations& o) {
     H += o.H; g += o.g;
@@ -78,12 +78,13 @@ struct Matcher {
     const std::optional<PlaneCoefficients>& plane =
         lookup(cache.planes[i], q, [&] { return match_plane(plane_map, q, neighborhood_sq, config); });
     if (!plane) return;
-    Vec3 r;
-    Mat36 J;
-    plane_residual(*plane, q, r, J);
-    if (r.norm() > max_residual_m) return;
-    eq.add(r, J, huber_weight(r.norm(), huber_delta));
-    residuals[cache.edges.size() + i] = static_cast<float>(r.norm());
+    // Eq 4.7 as its equivalent scalar row (residuals.hpp).
+    const PlaneRow row = plane_row(*plane, q);
+    const double norm = std::abs(row.residual);
+    if (norm > max_residual_m) return;
+    eq.add(row, huber_weight(norm, huber_delta));
+    eq.residual_sum += norm;
+    residuals[cache.edges.size() + i] = static_cast<float>(norm);
     ++eq.planes;
   }
 
@@ -92,20 +93,16 @@ struct Matcher {
     const Vec3 q = T * Vec3(p.cast<double>());
     const std::optional<MapLine>& line = lookup(cache.edges[i], q, [&] { return match_line(edge_map, q, neighborhood_sq, config); });
     if (!line) return;
+    // Eq 4.8: the two perpendicular planes through the line, one scalar row each.
     const EdgePlanes planes = edge_planes(line->point, line->direction, q);
-    Eigen::Matrix<double, 6, 1> r;
-    Eigen::Matrix<double, 6, 6> J;
-    Vec3 r1;
-    Mat36 J1;
-    plane_residual(planes.first, q, r1, J1);
-    r.head<3>() = r1;
-    J.topRows<3>() = J1;
-    plane_residual(planes.second, q, r1, J1);
-    r.tail<3>() = r1;
-    J.bottomRows<3>() = J1;
-    if (r.norm() > max_residual_m) return;
-    eq.add(r, J, huber_weight(r.norm(), huber_delta));
-    residuals[i] = static_cast<float>(r.norm());
+    const PlaneRow first = plane_row(planes.first, q), second = plane_row(planes.second, q);
+    const double norm = std::hypot(first.residual, second.residual);
+    if (norm > max_residual_m) return;
+    const double w = huber_weight(norm, huber_delta);
+    eq.add(first, w);
+    eq.add(second, w);
+    eq.residual_sum += norm;
+    residuals[i] = static_cast<float>(norm);
     ++eq.edges;
   }
 };
