@@ -309,6 +309,30 @@ TEST(Deskew, RedeskewEqualsDeskewingWithTheRefinedVelocity) {
   EXPECT_THROW(redeskew(std::span(times).first(3), predicted, measured, unchanged), std::invalid_argument);
 }
 
+// The same oracle for a fast turn (sweep angles past the small-angle series) and for no rotation at all.
+TEST(Deskew, RedeskewEqualsDeskewingDirectlyForFastAndNoRotation) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> coord(-20.0, 20.0), when(-0.05, 0.05);
+  const SE3 T_base_lidar(so3_exp(Vec3(0.3, 0.2, -0.1)), Vec3(0.1, 0.2, 0.3));
+  std::vector<Eigen::Vector3f> raw;
+  std::vector<float> times;
+  for (int i = 0; i < 300; ++i) {
+    raw.emplace_back(Vec3(coord(rng), coord(rng), coord(rng) / 4.0).cast<float>());
+    times.push_back(static_cast<float>(when(rng)));
+  }
+  BodyVelocity still, fast;
+  still.linear = Vec3(2.0, 0.0, 0.0);  // angular zero
+  fast.linear = Vec3(0.5, 1.0, 0.0);
+  fast.angular = Vec3(1.0, -2.0, 9.0);  // up to 0.46 rad within +-0.05 s
+  for (const auto& [from, to] : {std::pair{still, fast}, std::pair{fast, still}}) {
+    std::vector<Eigen::Vector3f> redeskewed(raw.size()), direct(raw.size());
+    deskew_to_base(raw, times, {}, T_base_lidar, from, redeskewed);
+    redeskew(times, from, to, redeskewed);
+    deskew_to_base(raw, times, {}, T_base_lidar, to, direct);
+    for (std::size_t i = 0; i < raw.size(); ++i) ASSERT_LT((redeskewed[i] - direct[i]).norm(), 1e-4) << i;
+  }
+}
+
 TEST(Deskew, VelocityFromRelativePoseRoundTrips) {
   const SE3 relative(so3_exp(Vec3(0.01, 0.02, 0.3)), Vec3(1.0, 0.2, -0.1));
   const BodyVelocity velocity = BodyVelocity::from_relative_pose(relative, 0.1);

@@ -107,6 +107,8 @@ std::vector<Field> fields(SlamConfig& c) {
        &odo.registration.max_iterations},
       {"odometry", "refine_deskew", {}, "deskew each frame again with the velocity its registration measured and register once more",
        &odo.refine_deskew},
+      {"odometry", "deskew_in_registration", {}, "deskew the features again between registration iterations with the velocity the estimate implies",
+       &odo.deskew_in_registration},
       {"odometry", "huber_delta_m", {0.0, 100.0, true, false}, "Huber scale on point residuals (eq 4.9's rho)",
        &odo.registration.huber_delta_m},
   };

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <numbers>
 #include <stdexcept>
@@ -167,11 +168,21 @@ void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, Fr
                                              result.registration.T_world_base, result.threshold_m, config_.registration);
 }
 
-RegistrationResult Odometry::register_robustly(const SE3& prediction, FrameResult& frame) {
+void Odometry::apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered) {
+  redeskew(frame_features_.edge_times, used, registered, frame_features_.edges);
+  redeskew(frame_features_.plane_times, used, registered, frame_features_.planes);
+  for (LidarFeatures& f : features_) {
+    redeskew(f.edge_times, used, registered, f.edges);
+    redeskew(f.plane_times, used, registered, f.planes);
+  }
+}
+
+RegistrationResult Odometry::register_robustly(const SE3& prediction, const MotionDeskew* motion, FrameResult& frame) {
   const double threshold = error_count_ == 0 ? config_.initial_threshold_m
                                              : std::max(config_.min_threshold_m, 3.0 * std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)));
   frame.threshold_m = threshold;
-  RegistrationResult best = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold, config_.registration);
+  RegistrationResult best =
+      register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold, config_.registration, motion);
   if (trusted(best)) return best;
   frame.retried = true;
   // Prefer a trusted candidate; among equals, the one whose matches are tighter.
@@ -184,7 +195,8 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, FrameResul
     // A coarse pass with the initial (wide) threshold, then a fine pass.
     const RegistrationResult coarse = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction * turn,
                                                            std::max(threshold, config_.initial_threshold_m), config_.registration);
-    RegistrationResult fine = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base, threshold, config_.registration);
+    RegistrationResult fine = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base,
+                                                   threshold, config_.registration, motion);
     if (better(fine, best)) best = fine;
     if (trusted(best)) break;
   }
@@ -220,8 +232,14 @@ FrameResult Odometry::process(const Frame& frame) {
   if (centroid_poses_.empty()) {
     result.registration.converged = true;
   } else {
-    result.registration = register_robustly(prediction, result);
-    if (config_.refine_deskew && centroid_poses_.size() >= 2 && trusted(result.registration)) refine_deskew(velocity, centroid_stamp, result);
+    std::optional<MotionDeskew> motion;
+    if (config_.deskew_in_registration && centroid_poses_.size() >= 2 && centroid_stamp > centroid_poses_.back().stamp)
+      motion = MotionDeskew{frame_features_.edge_times, frame_features_.plane_times, centroid_poses_.back().T_world_base,
+                            centroid_stamp - centroid_poses_.back().stamp, velocity};
+    result.registration = register_robustly(prediction, motion ? &*motion : nullptr, result);
+    const BodyVelocity deskewed_with = result.registration.velocity_used.value_or(velocity);
+    if (result.registration.velocity_used) apply_registered_deskew(velocity, deskewed_with);
+    if (config_.refine_deskew && centroid_poses_.size() >= 2 && trusted(result.registration)) refine_deskew(deskewed_with, centroid_stamp, result);
     T_world_centroid = result.registration.T_world_base;
     result.lost = result.registration.match_ratio() < config_.lost_match_ratio ||
                   result.registration.mean_residual_m > config_.trusted_mean_residual_m;

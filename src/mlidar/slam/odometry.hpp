@@ -59,6 +59,11 @@ struct OdometryConfig {
   /// registration (+40-55 % CPU per frame; ATE -10 to -50 % on handheld rhd,
   /// docs/benchmarks.md "Deskew of the base").
   bool refine_deskew = false;
+  /// Deskew the features again between registration iterations with the
+  /// velocity the current estimate implies (MotionDeskew in scan_to_map.hpp),
+  /// and map them with the last one: the prediction's velocity is a frame late
+  /// (ATE -20 to -45 % on the handheld protocol for +5 % CPU: docs/benchmarks.md).
+  bool deskew_in_registration = true;
 };
 
 struct FrameResult {
@@ -101,7 +106,9 @@ class Odometry {
  private:
   /// Constant velocity between the last two centroid poses (zero before two).
   BodyVelocity latest_velocity() const;
-  RegistrationResult register_robustly(const SE3& prediction, FrameResult& frame);
+  RegistrationResult register_robustly(const SE3& prediction, const MotionDeskew* motion, FrameResult& frame);
+  /// After a registration with MotionDeskew: the frame's features deskewed with the velocity it ended with.
+  void apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered);
   bool trusted(const RegistrationResult& registration) const;
   void refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result);
   void adapt_threshold(const SE3& prediction, const SE3& estimate);

@@ -142,10 +142,19 @@ void keep_initial_along_weak_translation(const SE3& initial, double threshold, R
 
 }  // namespace
 
-RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_base, std::span<const Eigen::Vector3f> planes_base,
+RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_in, std::span<const Eigen::Vector3f> planes_in,
                                         const VoxelMap& edge_map, const VoxelMap& plane_map, const SE3& initial,
-                                        double max_correspondence_m, const RegistrationConfig& config) {
+                                        double max_correspondence_m, const RegistrationConfig& config, const MotionDeskew* motion) {
+  // With a MotionDeskew the features are copied and deskewed again as the estimate moves.
+  std::vector<Eigen::Vector3f> edges_copy, planes_copy;
+  if (motion != nullptr) {
+    edges_copy.assign(edges_in.begin(), edges_in.end());
+    planes_copy.assign(planes_in.begin(), planes_in.end());
+  }
+  const std::span<const Eigen::Vector3f> edges_base = motion != nullptr ? std::span<const Eigen::Vector3f>(edges_copy) : edges_in;
+  const std::span<const Eigen::Vector3f> planes_base = motion != nullptr ? std::span<const Eigen::Vector3f>(planes_copy) : planes_in;
   RegistrationResult result;
+  if (motion != nullptr) result.velocity_used = motion->used;
   result.T_world_base = initial;
   result.queries = edges_base.size() + planes_base.size();
   result.residuals_m.assign(result.queries, std::numeric_limits<float>::quiet_NaN());
@@ -168,6 +177,13 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_b
     if (delta.head<3>().norm() < config.convergence_translation_m && delta.tail<3>().norm() < config.convergence_rotation_rad) {
       result.converged = true;
       break;
+    }
+    if (motion != nullptr) {
+      // Eq 4.12 again with the velocity this estimate implies.
+      const BodyVelocity measured = BodyVelocity::from_relative_pose(motion->T_world_previous.inverse() * result.T_world_base, motion->dt);
+      redeskew(motion->edge_times, *result.velocity_used, measured, edges_copy);
+      redeskew(motion->plane_times, *result.velocity_used, measured, planes_copy);
+      result.velocity_used = measured;
     }
   }
   result.eigenvalues = Eigen::SelfAdjointEigenSolver<Mat6>(result.hessian).eigenvalues();

@@ -22,9 +22,12 @@
 #include <span>
 #include <vector>
 
+#include <optional>
+
 #include <Eigen/Core>
 
 #include "mlidar/core/se3.hpp"
+#include "mlidar/slam/deskew.hpp"
 #include "mlidar/slam/voxel_map.hpp"
 
 namespace mlidar::slam {
@@ -63,13 +66,30 @@ struct RegistrationResult {
   /// |r| of each query (edges, then planes, in the order given) at the last
   /// linearisation; NaN where it had no correspondence within the gate.
   std::vector<float> residuals_m;
+  std::optional<BodyVelocity> velocity_used;  ///< with MotionDeskew: the features' final deskew velocity
 
   double match_ratio() const { return queries == 0 ? 0.0 : static_cast<double>(plane_matches + edge_matches) / static_cast<double>(queries); }
 };
 
+/// Deskew inside the registration: the features were deskewed (eq 4.12) with
+/// `used`, the previous frame's velocity; after each iteration they are
+/// deskewed again with the velocity from the previous centroid pose to the
+/// current estimate over dt, so the registration ends with the motion it
+/// measured (handheld acceleration otherwise biases the map a frame at a time).
+struct MotionDeskew {
+  std::span<const float> edge_times;   ///< per edge feature, s from the centroid
+  std::span<const float> plane_times;  ///< per plane feature
+  SE3 T_world_previous;                ///< the previous frame's centroid pose
+  double dt = 0.0;                     ///< centroid to centroid, s (> 0)
+  BodyVelocity used;                   ///< the velocity the features were deskewed with
+};
+
 /// max_correspondence_m bounds the residual of a correspondence (and is the least search radius).
+/// With `motion`, the features are deskewed again between iterations and
+/// `velocity_used` of the result holds the velocity of the last deskew.
 RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_base, std::span<const Eigen::Vector3f> planes_base,
                                         const VoxelMap& edge_map, const VoxelMap& plane_map, const SE3& initial,
-                                        double max_correspondence_m, const RegistrationConfig& config);
+                                        double max_correspondence_m, const RegistrationConfig& config,
+                                        const MotionDeskew* motion = nullptr);
 
 }  // namespace mlidar::slam
