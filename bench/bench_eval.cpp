@@ -18,8 +18,8 @@ Trajectory noisy_copy(const Trajectory& gt, unsigned seed) {
   Trajectory est = gt;
   for (StampedPose& pose : est.poses) {
     pose.stamp += 0.001 * noise(rng);
-    pose.T_world_base = pose.T_world_base * SE3(so3_exp(Vec3(noise(rng), noise(rng), noise(rng)) * 0.05),
-                                                Vec3(noise(rng), noise(rng), noise(rng)));
+    pose.T_world_base =
+        pose.T_world_base * SE3(so3_exp(Vec3(noise(rng), noise(rng), noise(rng)) * 0.05), Vec3(noise(rng), noise(rng), noise(rng)));
   }
   return est;
 }
@@ -28,8 +28,8 @@ Trajectory long_drive(std::size_t count) {
   Trajectory trajectory;
   for (std::size_t i = 0; i < count; ++i) {
     const double s = 0.001 * static_cast<double>(i);
-    trajectory.poses.push_back({0.1 * static_cast<double>(i),
-                                SE3(so3_exp(Vec3(0.0, 0.0, 3.0 * s)), Vec3(300.0 * std::cos(s), 200.0 * std::sin(2.0 * s), 0.0))});
+    trajectory.poses.push_back(
+        {0.1 * static_cast<double>(i), SE3(so3_exp(Vec3(0.0, 0.0, 3.0 * s)), Vec3(300.0 * std::cos(s), 200.0 * std::sin(2.0 * s), 0.0))});
   }
   return trajectory;
 }
@@ -57,11 +57,21 @@ std::vector<Eigen::Vector3f> room_cloud(std::size_t count, unsigned seed) {
     const float a = 30.0F * u(rng);
     const float b = u(rng);
     switch (static_cast<int>(5.0F * u(rng))) {
-      case 0: p = {a, 30.0F * b, noise(rng)}; break;
-      case 1: p = {a, noise(rng), 5.0F * b}; break;
-      case 2: p = {a, 30.0F + noise(rng), 5.0F * b}; break;
-      case 3: p = {noise(rng), a, 5.0F * b}; break;
-      default: p = {30.0F + noise(rng), a, 5.0F * b}; break;
+      case 0:
+        p = {a, 30.0F * b, noise(rng)};
+        break;
+      case 1:
+        p = {a, noise(rng), 5.0F * b};
+        break;
+      case 2:
+        p = {a, 30.0F + noise(rng), 5.0F * b};
+        break;
+      case 3:
+        p = {noise(rng), a, 5.0F * b};
+        break;
+      default:
+        p = {30.0F + noise(rng), a, 5.0F * b};
+        break;
     }
   }
   return points;

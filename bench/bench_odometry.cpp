@@ -33,7 +33,8 @@ struct Sequence {
       Frame frame;
       frame.stamp = k * rig.frame_period();
       for (std::size_t i = 0; i < rig.lidars.size(); ++i)
-        frame.scans.push_back(sim::simulate_sweep(scene, rig.lidars[i], trajectory, frame.stamp, sim::sweep_seed(3, static_cast<std::uint64_t>(k), i)).scan);
+        frame.scans.push_back(
+            sim::simulate_sweep(scene, rig.lidars[i], trajectory, frame.stamp, sim::sweep_seed(3, static_cast<std::uint64_t>(k), i)).scan);
       frames.push_back(std::move(frame));
     }
   }
@@ -82,7 +83,8 @@ void BM_Features(benchmark::State& state) {
   std::vector<double> angles = lidar.model.vertical_angles_deg;
   std::sort(angles.begin(), angles.end());
   Segmentation segmentation;
-  segment_range_image(image, scan.points, angles, (lidar.T_base_lidar.rotation().conjugate() * Vec3::UnitZ()).cast<float>(), {}, segmentation);
+  segment_range_image(image, scan.points, angles, (lidar.T_base_lidar.rotation().conjugate() * Vec3::UnitZ()).cast<float>(), {},
+                      segmentation);
   FeatureWorkspace workspace;
   FeatureIndices indices;
   for (auto _ : state) {

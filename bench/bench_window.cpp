@@ -9,7 +9,9 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#if MLIDAR_WITH_CERES
 #include "mlidar/slam/ceres_window.hpp"
+#endif
 #include "mlidar/slam/marginalization.hpp"
 #include "mlidar/slam/window_solver.hpp"
 #include "slam/window_scene.hpp"
@@ -85,6 +87,7 @@ void BM_SolverOurs(benchmark::State& bench) {
 }
 BENCHMARK(BM_SolverOurs)->Arg(2)->Arg(5)->Unit(benchmark::kMillisecond);
 
+#if MLIDAR_WITH_CERES
 void BM_SolverCeres(benchmark::State& bench) {
   const Window window = make_window(static_cast<int>(bench.range(0)));
   CeresWindowResult result;
@@ -95,6 +98,7 @@ void BM_SolverCeres(benchmark::State& bench) {
   solver_counters(bench, window, result.state, result.final_cost, result.iterations);
 }
 BENCHMARK(BM_SolverCeres)->Args({2, 0})->Args({2, 1})->Args({5, 0})->Unit(benchmark::kMillisecond);
+#endif
 
 void BM_WindowLinearize(benchmark::State& bench) {
   const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);

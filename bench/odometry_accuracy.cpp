@@ -46,13 +46,14 @@ void run(const RunSpec& spec) {
     Frame frame;
     frame.stamp = trajectory.start_time() + k * period;
     for (std::size_t i = 0; i < rig.lidars.size(); ++i)
-      frame.scans.push_back(sim::simulate_sweep(scene, rig.lidars[i], trajectory, frame.stamp,
-                                                sim::sweep_seed(spec.seed, static_cast<std::uint64_t>(k), i)).scan);
+      frame.scans.push_back(
+          sim::simulate_sweep(scene, rig.lidars[i], trajectory, frame.stamp, sim::sweep_seed(spec.seed, static_cast<std::uint64_t>(k), i))
+              .scan);
     const auto start = std::chrono::steady_clock::now();
     const slam::FrameResult result = odometry.process(frame);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     degenerate += result.registration.degenerate ? 1 : 0;
-    lost += result.lost ? 1 : 0;
+    lost += result.lost() ? 1 : 0;
     // The world frame is the base at the first stamp: express the truth the same way.
     gt.push_back(trajectory.T_world_base(trajectory.start_time()).inverse() * trajectory.T_world_base(frame.stamp));
     est.push_back(result.T_world_base);
@@ -64,8 +65,8 @@ void run(const RunSpec& spec) {
   const auto kitti = eval::compute_kitti_odometry(gt, est);
   double length = 0.0;
   for (std::size_t k = 1; k < gt.size(); ++k) length += (gt[k].translation() - gt[k - 1].translation()).norm();
-  std::printf("| %s/%s/%s | %zu | %d | %.1f | %.4f | %s | %s | %.1f | %d | %d |\n", spec.rig.c_str(), spec.scene.c_str(), spec.trajectory.c_str(),
-              rig.lidars.size(), spec.frames, length, ate.translation_m.rmse,
+  std::printf("| %s/%s/%s | %zu | %d | %.1f | %.4f | %s | %s | %.1f | %d | %d |\n", spec.rig.c_str(), spec.scene.c_str(),
+              spec.trajectory.c_str(), rig.lidars.size(), spec.frames, length, ate.translation_m.rmse,
               kitti ? std::to_string(kitti->translation_percent).c_str() : "-",
               kitti ? std::to_string(kitti->rotation_deg_per_100m).c_str() : "-", 1e3 * seconds / spec.frames, degenerate, lost);
 }
@@ -79,7 +80,11 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    mlidar::RunSpec spec{argv[1], argv[2], argv[3], std::atoi(argv[4]), std::strtoull(argv[5], nullptr, 10),
+    mlidar::RunSpec spec{argv[1],
+                         argv[2],
+                         argv[3],
+                         std::atoi(argv[4]),
+                         std::strtoull(argv[5], nullptr, 10),
                          argc > 6 ? static_cast<std::size_t>(std::atoi(argv[6])) : 0};
     std::printf("| run | LiDARs | frames | path m | ATE m | KITTI t %% | KITTI deg/100m | ms/frame | degenerate | lost |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|\n");

@@ -55,18 +55,30 @@ mlidar::Scan scan_of(const fs::path& file) { return mlidar::io::to_scan(mlidar::
 bool apply(Options& options, const std::string& key, double value) {
   mlidar::calib::PairRefineConfig& config = options.config;
   mlidar::calib::IcpLevel& last = config.icp.levels.back();
-  if (key == "min_range") config.min_range = value;
-  else if (key == "ref_voxel") config.ref_voxel_size = value;
-  else if (key == "k") config.surface.normal_neighbours = static_cast<std::size_t>(value);
-  else if (key == "planarity") config.surface.max_planarity = value;
-  else if (key == "kernel") last.kernel_scale = value;
-  else if (key == "last_voxel") last.voxel_size = value;
-  else if (key == "last_corr") last.max_correspondence = value;
-  else if (key == "perturbed") options.perturbed = value != 0.0;
-  else if (key == "reverse") options.reverse = value != 0.0;
-  else if (key == "restarts") options.restarts = static_cast<int>(value);
-  else if (key == "yaw_rate_0001") options.yaw_rate_0001_deg = value;
-  else return false;
+  if (key == "min_range")
+    config.min_range = value;
+  else if (key == "ref_voxel")
+    config.ref_voxel_size = value;
+  else if (key == "k")
+    config.surface.normal_neighbours = static_cast<std::size_t>(value);
+  else if (key == "planarity")
+    config.surface.max_planarity = value;
+  else if (key == "kernel")
+    last.kernel_scale = value;
+  else if (key == "last_voxel")
+    last.voxel_size = value;
+  else if (key == "last_corr")
+    last.max_correspondence = value;
+  else if (key == "perturbed")
+    options.perturbed = value != 0.0;
+  else if (key == "reverse")
+    options.reverse = value != 0.0;
+  else if (key == "restarts")
+    options.restarts = static_cast<int>(value);
+  else if (key == "yaw_rate_0001")
+    options.yaw_rate_0001_deg = value;
+  else
+    return false;
   return true;
 }
 
@@ -83,8 +95,8 @@ void deskew_yaw(mlidar::Scan& scan, double yaw_rate_deg) {
 }
 
 /// Largest rotation between the answer and the ends of `count` seeded restarts of the last two ICP levels.
-double restart_spread_deg(const std::vector<Eigen::Vector3f>& ref, const std::vector<Eigen::Vector3f>& target,
-                          const SE3& answer, const mlidar::calib::PairRefineConfig& config, int count) {
+double restart_spread_deg(const std::vector<Eigen::Vector3f>& ref, const std::vector<Eigen::Vector3f>& target, const SE3& answer,
+                          const mlidar::calib::PairRefineConfig& config, int count) {
   const auto beyond = [&](const std::vector<Eigen::Vector3f>& points) {
     std::vector<Eigen::Vector3f> kept;
     for (const Eigen::Vector3f& p : points)
@@ -150,16 +162,17 @@ int main(int argc, char** argv) {
       if (id == 0) continue;
       const std::string side = file.filename().string().rfind("left", 0) == 0 ? "left" : "right";
       const mlidar::Scan target = scan_of(file);
-      const auto r = mlidar::calib::refine_pair(top.points, target.points, guess(data_dir() / scene / "initial_extrinsic.txt", id),
-                                                options.config);
+      const auto r =
+          mlidar::calib::refine_pair(top.points, target.points, guess(data_dir() / scene / "initial_extrinsic.txt", id), options.config);
       const Vec3 rpy = mlidar::rpy_deg_from_quat(r.T_ref_target.rotation());
       const Vec3& t = r.T_ref_target.translation();
       const double icp_sd_deg = mlidar::rad_to_deg(std::sqrt(r.covariance_icp.bottomRightCorner<3, 3>().diagonal().maxCoeff()));
       std::printf("%s %-5s %-22s rpy %8.3f %7.3f %8.3f t %7.4f %7.4f %7.4f rmse %.3f overlap %.2f sd %.3f deg %.4f m (ICP alone %.3f deg)",
-                  scene.c_str(), side.c_str(), std::string(to_string(r.verdict)).c_str(), rpy.x(), rpy.y(), rpy.z(), t.x(),
-                  t.y(), t.z(), r.rmse, r.overlap.fraction_b, r.rotation_sd_deg, r.translation_sd_m, icp_sd_deg);
+                  scene.c_str(), side.c_str(), std::string(to_string(r.verdict)).c_str(), rpy.x(), rpy.y(), rpy.z(), t.x(), t.y(), t.z(),
+                  r.rmse, r.overlap.fraction_b, r.rotation_sd_deg, r.translation_sd_m, icp_sd_deg);
       if (options.restarts > 0)
-        std::printf(" restarts within %.3f deg", restart_spread_deg(top.points, target.points, r.T_ref_target, options.config, options.restarts));
+        std::printf(" restarts within %.3f deg",
+                    restart_spread_deg(top.points, target.points, r.T_ref_target, options.config, options.restarts));
       if (options.reverse) {
         mlidar::calib::PairRefineConfig reverse = options.config;
         reverse.search_mode = mlidar::calib::PairSearchMode::kNever;

@@ -99,8 +99,8 @@ int main(int argc, char** argv) {
       std::vector<double> seconds = cell.seconds;
       std::sort(seconds.begin(), seconds.end());
       const double median = seconds.empty() ? NAN : seconds[seconds.size() / 2];
-      std::printf("| %d | %d | %.4f | %.4f | %.4f | %.4f | %d/%d | %.3f |\n", configuration, 60 + 10 * k, r_mean, r_std,
-                  t_mean, t_std, cell.failures, trials, median);
+      std::printf("| %d | %d | %.4f | %.4f | %.4f | %.4f | %d/%d | %.3f |\n", configuration, 60 + 10 * k, r_mean, r_std, t_mean, t_std,
+                  cell.failures, trials, median);
     }
   }
   return 0;

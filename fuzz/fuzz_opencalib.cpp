@@ -24,7 +24,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           if (id < 0 || path.parent_path() != "scene") __builtin_trap();
         break;
       }
-      default: (void)mlidar::io::parse_opencalib_json(text, "fuzz.json");
+      default:
+        (void)mlidar::io::parse_opencalib_json(text, "fuzz.json");
     }
   } catch (const mlidar::InputError&) {
   }

@@ -5,9 +5,11 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build git pkg-config
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev lld
   libeigen3-dev libceres-dev libnanoflann-dev robin-map-dev libtbb-dev
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev liblzf-dev
+  libbz2-dev liblz4-dev libzstd-dev libsqlite3-dev
+  python3-yaml python3-rosbag python3-sensor-msgs python3-tf2-msgs python3-roslz4 python3-zstandard python3-lz4
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

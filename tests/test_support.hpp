@@ -17,10 +17,9 @@ inline std::filesystem::path shared_data() {
 }
 
 /// Skips the current test with a clear message when the shared data is missing.
-#define MLIDAR_REQUIRE_SHARED_DATA()                                                        \
-  do {                                                                                      \
-    if (::mlidar::test::shared_data().empty())                                              \
-      GTEST_SKIP() << "shared real data not found (set MLIDAR_SHARED_DATA to ../shared/data)"; \
+#define MLIDAR_REQUIRE_SHARED_DATA()                                                                                                    \
+  do {                                                                                                                                  \
+    if (::mlidar::test::shared_data().empty()) GTEST_SKIP() << "shared real data not found (set MLIDAR_SHARED_DATA to ../shared/data)"; \
   } while (0)
 
 /// A fresh empty folder under the system temp dir, unique per test and per

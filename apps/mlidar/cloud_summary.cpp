@@ -85,9 +85,8 @@ nlohmann::json to_json(const CloudSummary& s) {
   for (const auto& f : s.field_types) {
     fields.push_back({{"name", f.name}, {"type", io::scalar_name(f.type)}, {"count", f.count}});
   }
-  nlohmann::json j = {{"path", s.path},         {"format", s.format},   {"encoding", s.encoding},
-                      {"points", s.points},     {"width", s.width},     {"height", s.height},
-                      {"fields", fields},       {"nan_points", s.nan_points}};
+  nlohmann::json j = {{"path", s.path},   {"format", s.format}, {"encoding", s.encoding}, {"points", s.points},
+                      {"width", s.width}, {"height", s.height}, {"fields", fields},       {"nan_points", s.nan_points}};
   if (s.bounds) {
     const auto& lo = s.bounds->min();
     const auto& hi = s.bounds->max();

@@ -87,8 +87,8 @@ std::vector<double> row_major(const Mat6& m) {
 nlohmann::json report_json(const calib::PairRefineResult& r, double overlap_radius, double seconds) {
   nlohmann::json starts = nlohmann::json::array();
   for (const auto& s : r.starts)
-    starts.push_back({{"label", s.label}, {"start", pose_json(s.T_start)}, {"after", pose_json(s.T_after)},
-                      {"overlap", s.overlap}, {"rmse_m", s.rmse}});
+    starts.push_back(
+        {{"label", s.label}, {"start", pose_json(s.T_start)}, {"after", pose_json(s.T_after)}, {"overlap", s.overlap}, {"rmse_m", s.rmse}});
   return {{"verdict", std::string(calib::to_string(r.verdict))},
           {"reasons", r.reasons},
           {"searched", r.searched},
@@ -104,10 +104,11 @@ nlohmann::json report_json(const calib::PairRefineResult& r, double overlap_radi
           {"translation_sd_m", r.translation_sd_m},
           {"rmse_m", r.rmse},
           {"inlier_ratio", r.inlier_ratio},
-          {"overlap", {{"radius_m", overlap_radius},
-                       {"target_fraction", r.overlap.fraction_b},
-                       {"ref_fraction", r.overlap.fraction_a},
-                       {"omega", r.overlap.omega()}}},
+          {"overlap",
+           {{"radius_m", overlap_radius},
+            {"target_fraction", r.overlap.fraction_b},
+            {"ref_fraction", r.overlap.fraction_a},
+            {"omega", r.overlap.omega()}}},
           {"iterations", r.iterations},
           {"seconds", seconds}};
 }
@@ -123,8 +124,8 @@ void print_table(const calib::PairRefineResult& r, double seconds) {
   row("refined", r.T_ref_target);
   const SE3 change = r.T_init.inverse() * r.T_ref_target;
   std::printf("change %.3f deg, %.4f m; rmse %.4f m; overlap %.2f (omega %.3f); sd %.3f deg, %.4f m\n",
-              rad_to_deg(so3_log(change.rotation()).norm()), (r.T_ref_target.translation() - r.T_init.translation()).norm(),
-              r.rmse, r.overlap.fraction_b, r.overlap.omega(), r.rotation_sd_deg, r.translation_sd_m);
+              rad_to_deg(so3_log(change.rotation()).norm()), (r.T_ref_target.translation() - r.T_init.translation()).norm(), r.rmse,
+              r.overlap.fraction_b, r.overlap.omega(), r.rotation_sd_deg, r.translation_sd_m);
   std::printf("searched: %s", r.searched ? "yes" : "no");
   if (r.searched) std::printf(" (%zu starts, answer from '%s')", r.starts.size(), r.chosen_start.c_str());
   std::printf("; verdict: %s; %.2f s\n", std::string(calib::to_string(r.verdict)).c_str(), seconds);
@@ -133,6 +134,8 @@ void print_table(const calib::PairRefineResult& r, double seconds) {
 
 int run_refine(const RefineOptions& options) {
   if (options.ref_name == options.target_name) throw UsageError("--ref-name and --target-name must differ");
+  io::check_output_file(options.out, "--out");
+  if (!options.report.empty()) io::check_output_file(options.report, "--report");
   const SE3 T_init = read_initial_guess(options);
   const Scan ref = io::to_scan(io::read_cloud(options.ref).table, options.ref);
   const Scan target = io::to_scan(io::read_cloud(options.target).table, options.target);
@@ -147,8 +150,7 @@ int run_refine(const RefineOptions& options) {
   if (trusted) {
     io::Extrinsics extrinsics;
     extrinsics.base = options.ref_name;
-    extrinsics.lidars = {{options.ref_name, SE3(), std::nullopt},
-                         {options.target_name, result.T_ref_target, result.covariance}};
+    extrinsics.lidars = {{options.ref_name, SE3(), std::nullopt}, {options.target_name, result.T_ref_target, result.covariance}};
     io::write_extrinsics(options.out, extrinsics);
   }
   if (!options.report.empty()) {
@@ -178,8 +180,9 @@ Command add_calibrate_refine(CLI::App& calibrate) {
                   "and the reference or using it as base; or OpenCalib initial_extrinsic.txt (device 0 = reference, "
                   "the target is --target-id)")
       ->required();
-  cmd->add_option("--out", options->out, "Output extrinsics YAML (reference identity, target with covariance); "
-                                         "written only when the refinement converged")
+  cmd->add_option("--out", options->out,
+                  "Output extrinsics YAML (reference identity, target with covariance); "
+                  "written only when the refinement converged")
       ->required();
   cmd->add_option("--report", options->report, "JSON report: verdict, reasons, starts tried, overlap, covariance");
   cmd->add_option("--ref-name", options->ref_name, "Reference LiDAR name in --init YAML and --out")->capture_default_str();
@@ -188,8 +191,7 @@ Command add_calibrate_refine(CLI::App& calibrate) {
                   "OpenCalib device_id of the target in initial_extrinsic.txt (lidar_cloud_path.txt maps ids to clouds)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--search", options->search,
-                  "Multi-start search: auto (when the registration from the guess is poor), always, never")
+  cmd->add_option("--search", options->search, "Multi-start search: auto (when the registration from the guess is poor), always, never")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "always", "never"}));
   return {cmd, [options] { return run_refine(*options); }};

@@ -1,11 +1,13 @@
 // `mlidar convert IN OUT`: between PCD, PLY and KITTI .bin, keeping every
 // field the target format can hold. The output appears only when complete.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "apps/mlidar/commands.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/cloud_file.hpp"
 
 namespace mlidar::cli {
@@ -24,6 +26,10 @@ int run_convert(const ConvertOptions& options) {
   } catch (const InputError&) {
     throw UsageError("output '" + options.output + "' has no known extension (use .pcd, .ply or .bin)");
   }
+  io::check_output_file(options.output, "output");
+  std::error_code ec;
+  if (std::filesystem::equivalent(options.input, options.output, ec))
+    throw UsageError("output '" + options.output + "' is the input file; give another name (the input is never overwritten)");
   io::CloudReadOptions read_options;
   read_options.drop_nan = options.drop_nan;
   const io::CloudFile cloud = io::read_cloud(options.input, read_options);

@@ -61,11 +61,11 @@ bool is_kitti_format(const TrajOptions& options) {
   return std::filesystem::path(options.gt).extension() == ".kitti";
 }
 
-Trajectory read_trajectory(const std::string& path, bool kitti) {
-  return kitti ? io::read_kitti_poses(path) : io::read_tum(path);
-}
+Trajectory read_trajectory(const std::string& path, bool kitti) { return kitti ? io::read_kitti_poses(path) : io::read_tum(path); }
 
 int run_traj(const TrajOptions& options) {
+  if (!options.json_out.empty()) io::check_output_file(options.json_out, "--json");
+  if (!options.plot_out.empty()) io::check_output_file(options.plot_out, "--plot");
   const bool kitti = is_kitti_format(options);
   eval::TrajectoryEvalOptions eval_options;
   eval_options.align = parse_align(options.align);
@@ -79,14 +79,14 @@ int run_traj(const TrajOptions& options) {
   std::cout << eval::format_table(report);
   write_json(options.json_out, eval::to_json(report));
   if (!options.plot_out.empty()) {
-    const std::string svg =
-        eval::trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
+    const std::string svg = eval::trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
     io::write_atomically(options.plot_out, [&](std::ostream& out) { out << svg; });
   }
   return 0;
 }
 
 int run_calib(const CalibOptions& options) {
+  if (!options.json_out.empty()) io::check_output_file(options.json_out, "--json");
   const io::Extrinsics gt = io::read_extrinsics(options.gt);
   const io::Extrinsics est = io::read_extrinsics(options.est);
   const auto errors = eval::evaluate_calibration(gt, est, options.est);
@@ -98,6 +98,7 @@ int run_calib(const CalibOptions& options) {
 int run_map(const MapOptions& options) {
   if (!(options.radius > 0.0)) throw UsageError("--radius must be > 0");
   if (options.min_neighbors < 4) throw UsageError("--min-neighbors must be >= 4 (a 3D covariance needs 4 points)");
+  if (!options.json_out.empty()) io::check_output_file(options.json_out, "--json");
   const io::CloudFile cloud = io::read_cloud(options.map);
   const Scan scan = io::to_scan(cloud.table, options.map);
   const eval::MapMetricsOptions metrics_options{.radius = options.radius, .min_neighbors = options.min_neighbors};
@@ -116,9 +117,8 @@ void add_traj(CLI::App& eval_app, std::shared_ptr<TrajOptions> options) {
   sub->add_option("--align", options->align, "Alignment before ATE: se3 (Horn), sim3 (Umeyama), origin, none")
       ->check(CLI::IsMember({"se3", "sim3", "origin", "none"}))
       ->capture_default_str();
-  sub->add_option("--max-dt", options->max_dt, "Largest stamp difference (s) of associated poses (TUM)")
-      ->capture_default_str();
-  sub->add_option("--delta", options->delta, "RPE step")->capture_default_str();
+  sub->add_option("--max-dt", options->max_dt, "Largest stamp difference (s) of associated poses (TUM)")->capture_default_str();
+  sub->add_option("--delta", options->delta, "RPE step")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--delta-unit", options->delta_unit, "RPE step unit: frames or m")
       ->check(CLI::IsMember({"frames", "m"}))
       ->capture_default_str();
@@ -136,7 +136,7 @@ void add_calib(CLI::App& eval_app, std::shared_ptr<CalibOptions> options) {
 void add_map(CLI::App& eval_app, std::shared_ptr<MapOptions> options) {
   CLI::App* sub = eval_app.add_subcommand("map", "Mean map entropy and mean plane variance of a point cloud");
   sub->add_option("--map", options->map, "Map point cloud (PLY, PCD or .bin)")->required();
-  sub->add_option("--radius", options->radius, "Neighbourhood radius (m)")->capture_default_str();
+  sub->add_option("--radius", options->radius, "Neighbourhood radius (m)")->check(CLI::Range(1e-6, 1e6))->capture_default_str();
   sub->add_option("--min-neighbors", options->min_neighbors, "Fewest neighbours (self included) for a point to count")
       ->capture_default_str();
   sub->add_option("--json", options->json_out, "Write the metrics as JSON to this file");

@@ -4,6 +4,7 @@
 #include <sstream>
 #include <string>
 
+#include "apps/mlidar/bag_options.hpp"
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
@@ -14,9 +15,13 @@ namespace {
 struct OdometryOptions {
   std::string dataset;
   std::string scans;
+  BagCliOptions bag;
   double period = 0.1;
+  std::string times;
   std::string lidars;
   int threads = 0;
+  double max_base_gaps = pipelines::kDefaultMaxBaseGaps;
+  bool overwrite = false;
   std::string out;
 };
 
@@ -28,36 +33,61 @@ std::vector<std::string> split_names(const std::string& text) {
   return names;
 }
 
-int run_odometry(const OdometryOptions& options) {
+int run_odometry(const OdometryOptions& options, const CliContext& context) {
+  const std::string input = !options.dataset.empty() ? options.dataset : !options.scans.empty() ? options.scans : options.bag.bag;
+  io::RunFolder run(options.out, "odometry", context.run_folder(options.overwrite, {input}));
   pipelines::OdometryJob job;
   job.dataset = options.dataset;
   job.scans = options.scans;
+  job.bag = options.bag.bag;
+  job.bag_options = bag_source_options(options.bag);
   job.period = options.period;
+  if (!options.times.empty()) job.times = options.times;
   job.lidars = split_names(options.lidars);
   job.threads = options.threads;
-  job.out = options.out;
+  job.max_base_gaps = options.max_base_gaps;
+  job.out = run.path();
   const auto summary = pipelines::run_odometry_job(job, terminal_progress_bar());
+  run.commit();
   std::cout << "wrote " << options.out << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3 << " ms per frame, "
-            << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost\n";
+            << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost, " << summary.suspect_frames.size()
+            << " suspect\n";
   if (summary.degenerate_frames > 0)
-    std::cerr << "warning: " << summary.degenerate_frames << " frame(s) degenerate (translation weakly constrained, e.g. a corridor); see metrics.json\n";
+    std::cerr << "warning: " << summary.degenerate_frames
+              << " frame(s) degenerate (translation weakly constrained, e.g. a corridor); see metrics.json\n";
+  std::cerr << suspect_frames_warning(summary.suspect_frames);
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
-  return summary.lost_frames > 0 ? 1 : 0;
+  for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
+  if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';
+  return summary.lost_frames > 0 || summary.base_failure ? 1 : 0;
 }
 
 }  // namespace
 
-Command register_odometry(CLI::App& app) {
+Command register_odometry(CLI::App& app, const CliContext& context) {
   auto options = std::make_shared<OdometryOptions>();
   CLI::App* sub = app.add_subcommand("odometry", "Scan-to-map odometry from all LiDARs at once (known extrinsics)");
   auto* dataset = sub->add_option("--dataset", options->dataset, "Dataset folder (dataset.yaml, times.txt, scans/)");
   auto* scans = sub->add_option("--scans", options->scans, "Folder of single-LiDAR clouds, taken in natural order");
   dataset->excludes(scans);
-  sub->add_option("--period", options->period, "Seconds between clouds of --scans")->capture_default_str();
+  add_bag_options(*sub, options->bag, true, true);
+  auto* period = sub->add_option("--period", options->period, "Seconds between clouds of --scans")
+                     ->check(CLI::Range(1e-6, 86400.0).description("seconds in [1e-6, 86400]"))
+                     ->capture_default_str();
+  sub->add_option("--times", options->times,
+                  "With --scans, instead of --period: a file of one stamp per cloud (seconds, strictly increasing, '#' comments), "
+                  "in the clouds' natural order")
+      ->needs(scans)
+      ->excludes(period);
   sub->add_option("--lidars", options->lidars, "Comma-separated LiDAR names of the dataset (default: all)");
-  sub->add_option("--threads", options->threads, "Worker threads (0: all cores)")->capture_default_str();
-  sub->add_option("--out", options->out, "Run folder: trajectory.tum, trajectory.kitti, map.ply, metrics.json")->required();
-  return {sub, [options] { return run_odometry(*options); }};
+  sub->add_option("--threads", options->threads, "Worker threads (0: all cores)")->check(thread_count())->capture_default_str();
+  add_max_base_gaps_option(*sub, options->max_base_gaps);
+  sub->add_option(
+         "--out", options->out,
+         "Run folder: trajectory.tum, trajectory.kitti, map.ply, metrics.json, run.json (a new or empty folder, or an earlier run)")
+      ->required();
+  add_overwrite_flag(*sub, options->overwrite);
+  return {sub, [options, &context] { return run_odometry(*options, context); }};
 }
 
 }  // namespace mlidar::cli

@@ -1,4 +1,5 @@
 // `mlidar simulate drive|corner`: the built-in simulator with ground truth.
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -7,6 +8,7 @@
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/run_folder.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/sim/corner_dataset.hpp"
 #include "mlidar/sim/drive_dataset.hpp"
@@ -21,12 +23,14 @@ struct DriveOptions {
   int frames = 100;
   std::uint64_t seed = 1;
   std::string perturb = "0,0";
+  bool overwrite = false;
   std::string out;
 };
 
 struct CornerOptions {
   sim::CornerSpec spec;
   std::string angles = "60:120";
+  bool overwrite = false;
   std::string out;
 };
 
@@ -40,9 +44,9 @@ std::vector<double> split_numbers(const std::string& text, char separator, const
       std::size_t used = 0;
       const std::string part = text.substr(begin, end - begin);
       values.push_back(std::stod(part, &used));
-      if (used != part.size()) throw std::invalid_argument(part);
+      if (used != part.size() || !std::isfinite(values.back())) throw std::invalid_argument(part);
     } catch (const std::exception&) {
-      throw UsageError(option + " '" + text + "': expected numbers separated by '" + separator + "'");
+      throw UsageError(option + " '" + text + "': expected finite numbers separated by '" + separator + "'");
     }
     begin = end + 1;
   }
@@ -57,37 +61,42 @@ sim::SimTrajectory load_trajectory(const std::string& name, double base_height) 
   return sim::SimTrajectory::through(io::read_tum(name));
 }
 
-int run_drive(const DriveOptions& options) {
+int run_drive(const DriveOptions& options, const CliContext& context) {
+  const auto perturb = split_numbers(options.perturb, ',', "--perturb");
+  if (perturb.size() != 2 || perturb[0] < 0.0 || perturb[0] > 180.0 || perturb[1] < 0.0 || perturb[1] > 100.0)
+    throw UsageError("--perturb '" + options.perturb + "': expected DEG,M (degrees in [0, 180], metres in [0, 100])");
+  io::RunFolder run(options.out, "simulate drive", context.run_folder(options.overwrite, {}));
   sim::DriveSpec spec;
   spec.rig = sim::load_rig(options.rig);
   spec.scene = options.scene;
   spec.trajectory = load_trajectory(options.trajectory, spec.rig.base_height);
   spec.frames = options.frames;
   spec.seed = options.seed;
-  const auto perturb = split_numbers(options.perturb, ',', "--perturb");
-  if (perturb.size() != 2 || perturb[0] < 0.0 || perturb[1] < 0.0) throw UsageError("--perturb expects DEG,M (two non-negative numbers)");
   spec.perturb_deg = perturb[0];
   spec.perturb_m = perturb[1];
-  sim::write_drive_dataset(spec, options.out, terminal_progress_bar());
-  std::cout << "wrote " << options.out << ": " << spec.frames << " frames of " << spec.rig.lidars.size()
-            << " LiDAR(s), rig " << spec.rig.name << ", scene " << spec.scene << ", trajectory " << options.trajectory << '\n';
+  sim::write_drive_dataset(spec, run.path(), terminal_progress_bar());
+  run.commit();
+  std::cout << "wrote " << options.out << ": " << spec.frames << " frames of " << spec.rig.lidars.size() << " LiDAR(s), rig "
+            << spec.rig.name << ", scene " << spec.scene << ", trajectory " << options.trajectory << '\n';
   return 0;
 }
 
-int run_corner(CornerOptions& options) {
+int run_corner(CornerOptions& options, const CliContext& context) {
   const auto angles = split_numbers(options.angles, ':', "--angles");
   if (angles.size() < 2 || angles.size() > 3) throw UsageError("--angles expects A:B or A:B:STEP (degrees)");
   options.spec.angle_min = angles[0];
   options.spec.angle_max = angles[1];
   if (angles.size() == 3) options.spec.angle_step = angles[2];
-  sim::write_corner_dataset(options.spec, options.out);
+  io::RunFolder run(options.out, "simulate corner", context.run_folder(options.overwrite, {}));
+  sim::write_corner_dataset(options.spec, run.path());
+  run.commit();
   std::cout << "wrote " << options.out << ": two-LiDAR wall-corner clouds (thesis Table 2.2 protocol)\n";
   return 0;
 }
 
 }  // namespace
 
-Command register_simulate(CLI::App& app) {
+Command register_simulate(CLI::App& app, const CliContext& context) {
   CLI::App* sub = app.add_subcommand("simulate", "Simulate a multi-LiDAR dataset with ground truth");
   sub->require_subcommand(1);
 
@@ -96,24 +105,31 @@ Command register_simulate(CLI::App& app) {
   drive_cmd->add_option("--rig", drive->rig, "rhd, rv, lyft, single-vlp16, single-hdl64, or a rig .yaml")->capture_default_str();
   drive_cmd->add_option("--scene", drive->scene, "corner, room, corridor, campus, street")->capture_default_str();
   drive_cmd->add_option("--trajectory", drive->trajectory, "handheld, vehicle, corridor, static, or a TUM file")->capture_default_str();
-  drive_cmd->add_option("--frames", drive->frames, "Number of frames")->capture_default_str();
+  drive_cmd->add_option("--frames", drive->frames, "Number of frames")->check(CLI::Range(1, 1000000))->capture_default_str();
   drive_cmd->add_option("--seed", drive->seed, "Random seed (same seed, same bytes)")->capture_default_str();
   drive_cmd->add_option("--perturb", drive->perturb, "Perturb the initial extrinsics: DEG,M")->capture_default_str();
-  drive_cmd->add_option("--out", drive->out, "Output folder (must not exist or be empty)")->required();
+  drive_cmd->add_option("--out", drive->out, "Dataset folder (a new or empty folder, or an earlier simulate output)")->required();
+  add_overwrite_flag(*drive_cmd, drive->overwrite);
 
   auto corner = std::make_shared<CornerOptions>();
   CLI::App* corner_cmd = sub->add_subcommand("corner", "Thesis Table 2.2 protocol: two clouds of three planes");
-  corner_cmd->add_option("--out", corner->out, "Output folder (must not exist or be empty)")->required();
+  corner_cmd->add_option("--out", corner->out, "Output folder (a new or empty folder, or an earlier simulate output)")->required();
+  add_overwrite_flag(*corner_cmd, corner->overwrite);
   corner_cmd->add_option("--seed", corner->spec.seed, "Random seed")->capture_default_str();
-  corner_cmd->add_option("--noise", corner->spec.noise, "Plane noise sigma (m)")->capture_default_str();
-  corner_cmd->add_option("--outliers", corner->spec.outliers, "Outlier points per cloud")->capture_default_str();
-  corner_cmd->add_option("--points", corner->spec.points, "Points per cloud, outliers included")->capture_default_str();
+  corner_cmd->add_option("--noise", corner->spec.noise, "Plane noise sigma (m)")->check(CLI::Range(0.0, 10.0))->capture_default_str();
+  corner_cmd->add_option("--outliers", corner->spec.outliers, "Outlier points per cloud")
+      ->check(CLI::Range(0, 10000000))
+      ->capture_default_str();
+  corner_cmd->add_option("--points", corner->spec.points, "Points per cloud, outliers included")
+      ->check(CLI::Range(3, 10000000))
+      ->capture_default_str();
   corner_cmd->add_option("--angles", corner->angles, "Wall angles A:B[:STEP] in degrees (one frame each, step 10)")->capture_default_str();
-  corner_cmd->add_option("--configuration", corner->spec.configuration, "Ground truth: 1 or 2 (Table 2.2), 0 random")->capture_default_str();
+  corner_cmd->add_option("--configuration", corner->spec.configuration, "Ground truth: 1 or 2 (Table 2.2), 0 random")
+      ->capture_default_str();
 
-  return {sub, [drive, corner, drive_cmd] {
-            if (drive_cmd->parsed()) return run_drive(*drive);
-            return run_corner(*corner);
+  return {sub, [drive, corner, drive_cmd, &context] {
+            if (drive_cmd->parsed()) return run_drive(*drive, context);
+            return run_corner(*corner, context);
           }};
 }
 

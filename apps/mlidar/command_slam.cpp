@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/mlidar/bag_options.hpp"
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/pipelines/slam_job.hpp"
@@ -18,45 +19,83 @@ void print_lidar(const pipelines::SlamLidarReport& lidar) {
   const auto& sv = lidar.initialization.singular_values;
   if (lidar.role == pipelines::LidarRole::initializing && lidar.initialization.pairs_stored >= 10 && sv[2] < 0.1 * sv[1])
     std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
-  if (lidar.translation_start == "zero") std::cout << " (translation not solvable from motion: started from 0)";
+  if (lidar.translation_start == pipelines::TranslationStart::zero) std::cout << " (translation not solvable from motion: started from 0)";
   if (lidar.converged_frame) std::cout << ", converged at frame " << *lidar.converged_frame;
   if (lidar.restarts > 0) std::cout << ", " << lidar.restarts << " re-calibration(s) after an extrinsic shock";
   if (lidar.missing_frames > 0) std::cout << ", " << lidar.missing_frames << " frame(s) without a scan";
   std::cout << '\n';
   if (lidar.restarts == 0 && !lidar.reinitialization_frames.empty())
-    std::cout << "    re-initialized " << lidar.reinitialization_frames.size() << " time(s): its window residuals stayed high against the map\n";
+    std::cout << "    re-initialized " << lidar.reinitialization_frames.size()
+              << " time(s): its window residuals stayed high against the map\n";
   for (const auto& direction : lidar.unobservable_from_motion) {
     const bool observed = lidar.converged_frame.has_value() || lidar.accepted > 0;
     std::cout << "    unobservable from motion: " << direction << "; "
-              << (observed ? "observed by the calibration window (accepted against the map)" : "not yet observed by the calibration window") << '\n';
+              << (observed ? "observed by the calibration window (accepted against the map)" : "not yet observed by the calibration window")
+              << '\n';
   }
-  if (!lidar.axis_translation_source.empty()) std::cout << "    translation along the axis at the start: " << lidar.axis_translation_source << '\n';
-  for (const auto& weak : lidar.weak) std::cout << "    weakly observed: " << weak.description << " (information " << weak.eigenvalue << ")\n";
+  if (lidar.axis_translation_source != pipelines::AxisTranslationSource::none)
+    std::cout << "    translation along the axis at the start: " << pipelines::to_string(lidar.axis_translation_source) << '\n';
+  for (const auto& weak : lidar.weak)
+    std::cout << "    weakly observed: " << weak.description << " (information " << weak.eigenvalue << ")\n";
 }
 
-int run_slam(const pipelines::SlamJob& job) {
+struct SlamOptions {
+  pipelines::SlamJob job;
+  BagCliOptions bag;
+  std::string calibrate = "online";
+  bool overwrite = false;
+};
+
+pipelines::ExtrinsicSource extrinsic_source(const std::string& name) {
+  if (name == "fixed") return pipelines::ExtrinsicSource::fixed;
+  return name == "refine" ? pipelines::ExtrinsicSource::refine : pipelines::ExtrinsicSource::online;  // CLI11 checks the choice
+}
+
+int run_slam(SlamOptions options, const CliContext& context) {
+  io::RunFolder run(options.job.out, "slam",
+                    context.run_folder(options.overwrite, {options.job.dataset.empty() ? std::filesystem::path(options.bag.bag) : options.job.dataset}));
+  pipelines::SlamJob job = options.job;
+  job.bag = options.bag.bag;
+  job.bag_options = bag_source_options(options.bag);
+  job.calibrate = extrinsic_source(options.calibrate);
+  job.out = run.path();
   const auto summary = pipelines::run_slam_job(job, terminal_progress_bar());
-  std::cout << "wrote " << job.out.string() << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3 << " ms per frame, "
-            << summary.lost_frames << " lost\n";
+  run.commit();
+  std::cout << "wrote " << options.job.out.string() << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3
+            << " ms per frame, " << summary.lost_frames << " lost, " << summary.suspect_frames.size() << " suspect\n";
   for (const auto& lidar : summary.lidars) print_lidar(lidar);
   if (!summary.all_converged())
-    std::cerr << "warning: some LiDAR's calibration did not converge; its extrinsic in extrinsics.yaml has no covariance (see metrics.json)\n";
+    std::cerr
+        << "warning: some LiDAR's calibration did not converge; its extrinsic in extrinsics.yaml has no covariance (see metrics.json)\n";
+  std::cerr << suspect_frames_warning(summary.suspect_frames);
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
-  return summary.all_converged() && summary.lost_frames == 0 ? 0 : 1;
+  for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
+  if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';
+  return summary.all_converged() && summary.lost_frames == 0 && !summary.base_failure ? 0 : 1;
 }
 
 }  // namespace
 
-Command register_slam(CLI::App& app) {
-  auto job = std::make_shared<pipelines::SlamJob>();
+Command register_slam(CLI::App& app, const CliContext& context) {
+  auto options = std::make_shared<SlamOptions>();
+  pipelines::SlamJob* job = &options->job;
   CLI::App* sub = app.add_subcommand("slam", "Multi-LiDAR odometry with online extrinsic calibration (M-LOAM back end)");
-  sub->add_option("--dataset", job->dataset, "Dataset folder (dataset.yaml, times.txt, scans/)")->required();
+  sub->add_option("--dataset", job->dataset, "Dataset folder (dataset.yaml, times.txt, scans/)");
+  add_bag_options(*sub, options->bag, true, true);
   sub->add_option("--config", job->config, "Back-end parameters (config/mloam.yaml documents every key; default Table 4.2)");
-  sub->add_option("--calibrate", job->calibrate, "online: initialize and calibrate every LiDAR online; refine: calibrate from the dataset's extrinsics; fixed: use them as given")
+  sub->add_option(
+         "--calibrate", options->calibrate,
+         "online: initialize and calibrate every LiDAR online; refine: calibrate from the dataset's extrinsics; fixed: use them as given")
+      ->check(CLI::IsMember({"online", "refine", "fixed"}))
       ->capture_default_str();
-  sub->add_option("--threads", job->threads, "Worker threads (0: all cores)")->capture_default_str();
-  sub->add_option("--out", job->out, "Run folder: trajectory.tum/.kitti, extrinsics.yaml, map.ply, metrics.json")->required();
-  return {sub, [job] { return run_slam(*job); }};
+  sub->add_option("--threads", job->threads, "Worker threads (0: all cores)")->check(thread_count())->capture_default_str();
+  add_max_base_gaps_option(*sub, job->max_base_gaps);
+  sub->add_option("--out", job->out,
+                  "Run folder: trajectory.tum/.kitti, extrinsics.yaml, map.ply, metrics.json, run.json (a new or empty folder, or an "
+                  "earlier run)")
+      ->required();
+  add_overwrite_flag(*sub, options->overwrite);
+  return {sub, [options, &context] { return run_slam(*options, context); }};
 }
 
 }  // namespace mlidar::cli

@@ -1,25 +1,71 @@
 // mlidar command-line entry point: parses the command line and maps errors to
-// the documented exit codes (0 ok, 1 untrusted/failed, 2 usage, 3 bad input).
+// the documented exit codes (0 ok, 1 untrusted/failed, 2 usage, 3 bad input,
+// 130/143 interrupted by SIGINT/SIGTERM).
+#include <malloc.h>
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
 #include "apps/mlidar/commands.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/core/version.hpp"
+#include "mlidar/io/interrupt_cleanup.hpp"
+
+namespace {
+
+/// SIGINT and SIGTERM go to one thread (blocked everywhere else, before any worker thread starts): it removes the
+/// unfinished outputs (temporary files, staging folders) and exits 128 + the signal (130, 143).
+void handle_interrupts() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  std::thread([signals] {
+    int signal = 0;
+    if (sigwait(&signals, &signal) != 0) return;
+    const std::size_t removed = mlidar::io::remove_unfinished_outputs();
+    std::fprintf(stderr, "mlidar: interrupted (%s); removed %zu unfinished output(s), earlier outputs are unchanged\n",
+                 signal == SIGINT ? "SIGINT" : "SIGTERM", removed);
+    _exit(128 + signal);
+  }).detach();
+}
+
+}  // namespace
+
+/// Large buffers (a decoded scan, a decompressed chunk: 0.2-1 MB, each frame) stay in the heap instead of being
+/// mapped and unmapped every time: the page faults and zeroing of fresh pages took 60 % of `bag export` (900 MB
+/// bag: 4.1 s -> 1.6 s); slam's time per frame is unchanged.
+void keep_large_buffers_in_the_heap() {
+  constexpr int kBytes = 256 << 20;
+  mallopt(M_MMAP_THRESHOLD, kBytes);
+  mallopt(M_TRIM_THRESHOLD, kBytes);
+}
 
 int main(int argc, char** argv) {
   using mlidar::ExitCode;
+  keep_large_buffers_in_the_heap();
+  handle_interrupts();
   CLI::App app{"mlidar: calibration, odometry, mapping and detection for robots with several LiDARs"};
   app.footer(
       "Exit codes:\n"
-      "  0  ok\n"
-      "  1  the job ran but failed or its result should not be trusted (no convergence, degenerate)\n"
-      "  2  usage error (bad command line or configuration, output that cannot be written)\n"
-      "  3  bad input data (unreadable, truncated or invalid file)");
+      "  0    ok\n"
+      "  1    the job ran but failed or its result should not be trusted (no convergence, degenerate)\n"
+      "  2    usage error (bad command line, an output that cannot be written or may not be replaced)\n"
+      "  3    bad input data or configuration file (the message names the file and field)\n"
+      "  130  interrupted (SIGINT), 143 terminated (SIGTERM): unfinished outputs removed, earlier ones unchanged");
   app.require_subcommand(1);
-  app.set_version_flag("--version", "mlidar 0.1.0");
-  const auto commands = mlidar::cli::register_commands(app);
+  app.set_version_flag("--version", std::string("mlidar ") + mlidar::kVersion);
+  const mlidar::cli::CliContext context{std::vector<std::string>(argv, argv + argc)};
+  const auto commands = mlidar::cli::register_commands(app, context);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -40,6 +86,9 @@ int main(int argc, char** argv) {
   } catch (const mlidar::OutputError& e) {
     std::cerr << "mlidar: cannot write output: " << e.what() << '\n';
     return static_cast<int>(ExitCode::kUsage);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "mlidar: failed: out of memory\n";
+    return static_cast<int>(ExitCode::kUntrusted);
   } catch (const std::exception& e) {
     std::cerr << "mlidar: failed: " << e.what() << '\n';
     return static_cast<int>(ExitCode::kUntrusted);

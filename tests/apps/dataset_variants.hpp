@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the CLI tests that run a job twice on one simulated dataset: a
-// variant of its folder, and the pose differences they compare.
+// variant of its folder (the pose differences they compare: pose_error.hpp).
 #include <algorithm>
 #include <filesystem>
 
@@ -8,11 +8,9 @@
 #include "mlidar/core/se3.hpp"
 #include "mlidar/io/dataset.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "pose_error.hpp"
 
 namespace mlidar::test {
-
-inline double rotation_deg(const SE3& a, const SE3& b) { return rad_to_deg((a.inverse() * b).log().tail<3>().norm()); }
-inline double translation_m(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
 
 /// A copy of the dataset folder `sim` at `out` (scans shared through a link,
 /// ground truth left out) with its LiDARs listed in reverse order and/or the

@@ -21,13 +21,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
-
 TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
   const fs::path dir = scratch_dir();
   const fs::path sim = dir / "rhd";
-  ASSERT_EQ(run_cli("simulate drive --rig rhd --scene campus --trajectory handheld --frames 50 --seed 1 --out " +
-                    quoted(sim.string())).exit_code, 0);
+  ASSERT_EQ(
+      run_cli("simulate drive --rig rhd --scene campus --trajectory handheld --frames 50 --seed 1 --out " + quoted(sim.string())).exit_code,
+      0);
   const fs::path run = dir / "run";
   const CliResult result = run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --out " + quoted(run.string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
@@ -40,8 +39,8 @@ TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
   const SE3& T_true = truth.find("right")->T_base_lidar;
   const SE3& T_est = estimate.find("right")->T_base_lidar;
   // Hand-eye alone on 50 frames of odometry (the initial guess in dataset.yaml is not used).
-  EXPECT_LT(rotation_deg(T_true, T_est), 1.0);
-  EXPECT_LT(translation_m(T_true, T_est), 0.3);
+  EXPECT_LT(rotation_error_deg(T_true, T_est), 1.0);
+  EXPECT_LT(translation_error_m(T_true, T_est), 0.3);
   const auto json = nlohmann::json::parse(std::ifstream(run / "calibration.json"));
   EXPECT_EQ(json["lidars"][1]["handeye"]["verdict"], "ok");
   EXPECT_GT(json["lidars"][1]["handeye"]["pairs_used"].get<int>(), 10);
@@ -49,30 +48,30 @@ TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
 
   const fs::path reversed = dataset_variant(sim, dir / "reversed", true, false);
   const fs::path run2 = dir / "run2";
-  ASSERT_EQ(run_cli("calibrate auto --dataset " + quoted(reversed.string()) + " --base left --out " +
-                    quoted(run2.string())).exit_code, 0);
+  ASSERT_EQ(run_cli("calibrate auto --dataset " + quoted(reversed.string()) + " --base left --out " + quoted(run2.string())).exit_code, 0);
   const io::Extrinsics reordered = io::read_extrinsics(run2 / "extrinsics.yaml");
   ASSERT_NE(reordered.find("right"), nullptr);
   const SE3 T_reordered = reordered.find("right")->T_base_lidar;
-  EXPECT_LT(rotation_deg(T_est, T_reordered), 0.01);
-  EXPECT_LT(translation_m(T_est, T_reordered), 0.001);
+  EXPECT_LT(rotation_error_deg(T_est, T_reordered), 0.01);
+  EXPECT_LT(translation_error_m(T_est, T_reordered), 0.001);
 }
 
 TEST(CliAutoCalib, StaticRigIsReportedNotCalibrated) {
   const fs::path dir = scratch_dir();
   const fs::path sim = dir / "static";
-  ASSERT_EQ(run_cli("simulate drive --rig rhd --scene campus --trajectory static --frames 12 --seed 1 --out " +
-                    quoted(sim.string())).exit_code, 0);
+  ASSERT_EQ(
+      run_cli("simulate drive --rig rhd --scene campus --trajectory static --frames 12 --seed 1 --out " + quoted(sim.string())).exit_code,
+      0);
   const fs::path run = dir / "run";
   const CliResult result = run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --out " + quoted(run.string()));
   EXPECT_EQ(result.exit_code, 1) << result.output;
   const auto json = nlohmann::json::parse(std::ifstream(run / "calibration.json"));
   EXPECT_NE(json["lidars"][1]["handeye"]["verdict"], "ok");
   EXPECT_FALSE(json["all_usable"].get<bool>());
-  EXPECT_EQ(run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --stage polish --out " +
-                    quoted((dir / "x").string())).exit_code, 2);
-  EXPECT_EQ(run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --base nosuch --out " +
-                    quoted((dir / "y").string())).exit_code, 2);
+  EXPECT_EQ(run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --stage polish --out " + quoted((dir / "x").string())).exit_code,
+            2);
+  EXPECT_EQ(run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --base nosuch --out " + quoted((dir / "y").string())).exit_code,
+            2);
 }
 
 }  // namespace

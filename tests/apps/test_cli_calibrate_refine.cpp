@@ -22,8 +22,8 @@ fs::path scene() { return shared_data() / "real" / "opencalib_3lidar" / "0001"; 
 
 std::string pair_arguments() {
   // lidar_cloud_path.txt of scene 0001: device 0 = top.pcd, 2 = right.pcd.
-  return "calibrate refine --ref " + quoted((scene() / "top.pcd").string()) + " --target " +
-         quoted((scene() / "right.pcd").string()) + " --ref-name top --target-name right --target-id 2";
+  return "calibrate refine --ref " + quoted((scene() / "top.pcd").string()) + " --target " + quoted((scene() / "right.pcd").string()) +
+         " --ref-name top --target-name right --target-id 2";
 }
 
 TEST(CliCalibrateRefine, RealPairWritesExtrinsicsThatReadBack) {
@@ -31,8 +31,8 @@ TEST(CliCalibrateRefine, RealPairWritesExtrinsicsThatReadBack) {
   const fs::path dir = scratch_dir();
   const fs::path out = dir / "out.yaml";
   const fs::path report = dir / "report.json";
-  const CliResult result = run_cli(pair_arguments() + " --init " + quoted((scene() / "initial_extrinsic.txt").string()) +
-                                   " --out " + quoted(out.string()) + " --report " + quoted(report.string()));
+  const CliResult result = run_cli(pair_arguments() + " --init " + quoted((scene() / "initial_extrinsic.txt").string()) + " --out " +
+                                   quoted(out.string()) + " --report " + quoted(report.string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("verdict"), std::string::npos) << result.output;
   const io::Extrinsics extrinsics = io::read_extrinsics(out);
@@ -44,8 +44,7 @@ TEST(CliCalibrateRefine, RealPairWritesExtrinsicsThatReadBack) {
   ASSERT_TRUE(right->covariance.has_value());
   const auto json = nlohmann::json::parse(std::ifstream(report));
   EXPECT_NE(json["verdict"], "not_converged");
-  for (int i = 0; i < 3; ++i)
-    EXPECT_NEAR(json["T_ref_target"]["translation"][i].get<double>(), right->T_base_lidar.translation()(i), 1e-9);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(json["T_ref_target"]["translation"][i].get<double>(), right->T_base_lidar.translation()(i), 1e-9);
   EXPECT_EQ(json["covariance"].size(), 36U);
 }
 

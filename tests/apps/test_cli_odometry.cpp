@@ -4,6 +4,8 @@
 // and leaves no run folder behind.
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -76,7 +78,8 @@ TEST(CliOdometry, ScanFolderOfOneLidarTracksThatLidar) {
   const fs::path dir = scratch_dir();
   const fs::path sim = simulate_drive(dir);
   const fs::path run = dir / "run";
-  const auto result = run_cli("odometry --scans " + quoted((sim / "scans" / "top").string()) + " --period 0.1 --out " + quoted(run.string()));
+  const auto result =
+      run_cli("odometry --scans " + quoted((sim / "scans" / "top").string()) + " --period 0.1 --out " + quoted(run.string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const Trajectory est = read_run_folder(run);
   // The folder's trajectory is the top LiDAR's: T_world_top = T_world_base T_base_top.
@@ -99,6 +102,93 @@ TEST(CliOdometry, BadInputExitsThreeAndWritesNothing) {
   EXPECT_EQ(result.exit_code, 3) << result.output;
   EXPECT_NE(result.output.find("no .pcd"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(run));
+}
+
+// Real BALM keyframes 20..27 with the sixth (index 5) given 12 cm of point noise:
+// it fits clearly worse than the frames before, so the terminal and metrics.json
+// name it suspect, and the run still exits 0 with every frame's pose.
+TEST(CliOdometry, AFrameThatFitsWorseIsNamedSuspect) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  const fs::path dir = scratch_dir();
+  const fs::path frames = dir / "frames";
+  fs::create_directories(frames);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0F, 0.12F);
+  for (int k = 20; k < 28; ++k) {
+    const std::string name = "full" + std::to_string(k) + ".pcd";
+    io::CloudFile cloud = io::read_cloud(shared_data() / "real" / "balm_ouster" / "frames" / name);
+    if (k == 25) {
+      for (const char* axis : {"x", "y", "z"}) {
+        io::FieldColumn* column = cloud.table.find(axis);
+        ASSERT_NE(column, nullptr);
+        ASSERT_EQ(column->type, io::ScalarType::kF32);
+        auto* values = reinterpret_cast<float*>(column->data.data());
+        for (std::size_t i = 0; i < cloud.table.num_points; ++i) values[i] += noise(rng);
+      }
+    }
+    io::write_cloud(frames / name, cloud);
+  }
+  const fs::path run = dir / "run";
+  const CliResult result = run_cli("odometry --scans " + quoted(frames.string()) + " --period 0.5 --out " + quoted(run.string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("0 lost, 1 suspect"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("1 frame suspect (frame 5,"), std::string::npos) << result.output;
+  const auto metrics = nlohmann::json::parse(std::ifstream(run / "metrics.json"));
+  EXPECT_EQ(metrics["suspect_frames"], 1);
+  ASSERT_EQ(metrics["per_frame"].size(), 8u);
+  for (std::size_t k = 0; k < 8; ++k) {
+    EXPECT_EQ(metrics["per_frame"][k]["suspect"], k == 5) << "frame " << k;
+    EXPECT_EQ(metrics["per_frame"][k]["trust"], k == 5 ? "residual" : "trusted") << "frame " << k;
+  }
+  EXPECT_GT(metrics["per_frame"][5]["mean_residual_m"].get<double>(), 2.0 * metrics["per_frame"][5]["recent_residual_m"].get<double>());
+  EXPECT_EQ(io::read_tum(run / "trajectory.tum").poses.size(), 8u);
+}
+
+// Real keyframes are rarely evenly spaced: --times gives each cloud its stamp
+// (here BALM's own, from the reference file). The trajectory carries them, and
+// a file that does not hold one increasing stamp per cloud is exit 3 naming it.
+TEST(CliOdometry, ScanFolderTakesOneStampPerCloudFromTimes) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  const fs::path dir = scratch_dir();
+  const fs::path balm = shared_data() / "real" / "balm_ouster";
+  const Trajectory reference = io::read_balm_poses(balm / "alidarPose_0-49.csv");
+  const fs::path frames = dir / "frames";
+  fs::create_directories(frames);
+  std::ofstream times(dir / "times.txt");
+  times << "# BALM keyframes 20..25\n" << std::setprecision(17);
+  for (int k = 20; k < 26; ++k) {
+    const std::string name = "full" + std::to_string(k) + ".pcd";
+    fs::copy_file(balm / "frames" / name, frames / name);
+    times << reference.poses[static_cast<std::size_t>(k)].stamp << '\n';
+  }
+  times.close();
+  const fs::path run = dir / "run";
+  CliResult result =
+      run_cli("odometry --scans " + quoted(frames.string()) + " --times " + quoted((dir / "times.txt").string()) + " --out " + quoted(run.string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const Trajectory tum = io::read_tum(run / "trajectory.tum");
+  ASSERT_EQ(tum.poses.size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(tum.poses[i].stamp, reference.poses[20 + i].stamp, 1e-6) << "frame " << i;
+  // The stamps are real (0.5 s +- jitter): the relative motion still follows the reference.
+  const SE3 moved = tum.poses.front().T_world_base.inverse() * tum.poses.back().T_world_base;
+  const SE3 truth = reference.poses[20].T_world_base.inverse() * reference.poses[25].T_world_base;
+  EXPECT_LT((moved.inverse() * truth).translation().norm(), 0.05);
+
+  std::ofstream(dir / "short.txt") << "0\n0.5\n1\n";
+  result = run_cli("odometry --scans " + quoted(frames.string()) + " --times " + quoted((dir / "short.txt").string()) + " --out " +
+                   quoted((dir / "run2").string()));
+  EXPECT_EQ(result.exit_code, 3) << result.output;
+  EXPECT_NE(result.output.find("short.txt"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("3 stamps for 6 clouds"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(dir / "run2"));
+  std::ofstream(dir / "unsorted.txt") << "0\n0.5\n1\n0.9\n2\n2.5\n";
+  result = run_cli("odometry --scans " + quoted(frames.string()) + " --times " + quoted((dir / "unsorted.txt").string()) + " --out " +
+                   quoted((dir / "run2").string()));
+  EXPECT_EQ(result.exit_code, 3) << result.output;
+  EXPECT_NE(result.output.find("line 4"), std::string::npos) << result.output;
+  result = run_cli("odometry --scans " + quoted(frames.string()) + " --times " + quoted((dir / "short.txt").string()) +
+                   " --period 0.5 --out " + quoted((dir / "run2").string()));
+  EXPECT_EQ(result.exit_code, 2) << result.output;  // --times excludes --period
 }
 
 }  // namespace

@@ -19,16 +19,15 @@ namespace {
 namespace fs = std::filesystem;
 
 struct BrokenFile {
-  const char* name;       // file name (its extension picks the reader)
-  std::string content;    // the broken bytes
-  const char* field;      // what the message must name
+  const char* name;     // file name (its extension picks the reader)
+  std::string content;  // the broken bytes
+  const char* field;    // what the message must name
 };
 
-std::string pcd_header(const std::string& fields, const std::string& size, const std::string& type,
-                       const std::string& count, int width, int points, const std::string& data) {
-  return "VERSION 0.7\nFIELDS " + fields + "\nSIZE " + size + "\nTYPE " + type + "\nCOUNT " + count + "\nWIDTH " +
-         std::to_string(width) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) +
-         "\nDATA " + data + "\n";
+std::string pcd_header(const std::string& fields, const std::string& size, const std::string& type, const std::string& count, int width,
+                       int points, const std::string& data) {
+  return "VERSION 0.7\nFIELDS " + fields + "\nSIZE " + size + "\nTYPE " + type + "\nCOUNT " + count + "\nWIDTH " + std::to_string(width) +
+         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " + data + "\n";
 }
 
 std::string xyz_header(int width, int points, const std::string& data) {
@@ -58,8 +57,11 @@ std::vector<BrokenFile> broken_files() {
       {"no_magic.ply", "plx\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n", "ply"},
       {"bad_format.ply", "ply\nformat utf8 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n", "format"},
       {"bad_type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n0\n", "property"},
-      {"short.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
-                    "property float z\nend_header\n" + std::string(7, '\0'), "vertex"},
+      {"short.ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n" +
+           std::string(7, '\0'),
+       "vertex"},
       {"odd_size.bin", std::string(18, '\0'), "size"},
   };
 }
@@ -106,19 +108,22 @@ struct BrokenExtrinsics {
   const char* key;
 };
 
-const char* const kGoodExtrinsics =
-    "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n";
+const char* const kGoodExtrinsics = "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n";
 
 const BrokenExtrinsics kBrokenExtrinsics[] = {
-    {"unknown_key", "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n"
-                    "    colour: red\n", "colour"},
+    {"unknown_key",
+     "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n"
+     "    colour: red\n",
+     "colour"},
     {"non_unit_quaternion", "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0.1, 0]\n",
      "quaternion_wxyz"},
-    {"non_psd_covariance", "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n"
-                           "    covariance: [-1,0,0,0,0,0, 0,1,0,0,0,0, 0,0,1,0,0,0, 0,0,0,1,0,0, 0,0,0,0,1,0, 0,0,0,0,0,1]\n",
+    {"non_psd_covariance",
+     "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n"
+     "    covariance: [-1,0,0,0,0,0, 0,1,0,0,0,0, 0,0,1,0,0,0, 0,0,0,1,0,0, 0,0,0,0,1,0, 0,0,0,0,0,1]\n",
      "covariance"},
-    {"asymmetric_covariance", "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n"
-                              "    covariance: [1,0.5,0,0,0,0, 0,1,0,0,0,0, 0,0,1,0,0,0, 0,0,0,1,0,0, 0,0,0,0,1,0, 0,0,0,0,0,1]\n",
+    {"asymmetric_covariance",
+     "base: base\nlidars:\n  top:\n    translation: [0, 0, 1]\n    quaternion_wxyz: [1, 0, 0, 0]\n"
+     "    covariance: [1,0.5,0,0,0,0, 0,1,0,0,0,0, 0,0,1,0,0,0, 0,0,0,1,0,0, 0,0,0,0,1,0, 0,0,0,0,0,1]\n",
      "covariance"},
 };
 
@@ -128,8 +133,7 @@ TEST(CliRejectsExtrinsics, EvalCalibExitsThreeNamingTheKey) {
   for (const auto& broken : kBrokenExtrinsics) {
     const fs::path file = dir / (std::string(broken.name) + ".yaml");
     std::ofstream(file) << broken.yaml;
-    const CliResult result =
-        run_cli("eval calib --gt " + quoted((dir / "good.yaml").string()) + " --est " + quoted(file.string()));
+    const CliResult result = run_cli("eval calib --gt " + quoted((dir / "good.yaml").string()) + " --est " + quoted(file.string()));
     EXPECT_EQ(result.exit_code, 3) << broken.name << ": " << result.output;
     EXPECT_NE(result.output.find(file.filename().string()), std::string::npos) << result.output;
     EXPECT_NE(result.output.find(broken.key), std::string::npos) << broken.name << ": " << result.output;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/se3.hpp"
 
 namespace mlidar::test {
@@ -20,11 +21,8 @@ struct CornerClouds {
   SE3 T_ref_target;
 };
 
-inline SE3 zyx_pose(double yaw, double pitch, double roll, const Vec3& t) {
-  return SE3(Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
-                  Eigen::AngleAxisd(roll, Vec3::UnitX())),
-             t);
-}
+/// R = Rz(yaw) Ry(pitch) Rx(roll) (rad), the library's roll-pitch-yaw convention, and t.
+inline SE3 zyx_pose(double yaw, double pitch, double roll, const Vec3& t) { return SE3(quat_from_rpy(Vec3(roll, pitch, yaw)), t); }
 
 /// Table 2.2 configuration 1 or 2 (read as ZYX Euler angles, as the simulator does).
 inline SE3 thesis_configuration(int which) {
@@ -33,8 +31,7 @@ inline SE3 thesis_configuration(int which) {
 }
 
 /// `planar` points over the `planes` first planes of the corner (floor last), `outliers` N(0, 5^2) points.
-inline std::vector<Vec3> corner_world_points(double alpha, int planar, int outliers, double noise, int planes,
-                                             std::mt19937_64& rng) {
+inline std::vector<Vec3> corner_world_points(double alpha, int planar, int outliers, double noise, int planes, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> gauss(0.0, 1.0);
   const Vec3 wall2(std::cos(alpha), std::sin(alpha), 0.0);
@@ -66,11 +63,10 @@ inline std::vector<Eigen::Vector3f> to_lidar(const std::vector<Vec3>& world, con
   return out;
 }
 
-inline CornerClouds make_corner(double alpha_deg, const SE3& T_ref_target, int planar, int outliers, double noise,
-                                std::uint64_t seed, int planes = 3) {
+inline CornerClouds make_corner(double alpha_deg, const SE3& T_ref_target, int planar, int outliers, double noise, std::uint64_t seed,
+                                int planes = 3) {
   const double alpha = alpha_deg * std::numbers::pi / 180.0;
-  const SE3 T_world_ref = zyx_pose(alpha / 2 + std::numbers::pi, 0.0, 0.0,
-                                   Vec3(4 * std::cos(alpha / 2), 4 * std::sin(alpha / 2), 1.5));
+  const SE3 T_world_ref = zyx_pose(alpha / 2 + std::numbers::pi, 0.0, 0.0, Vec3(4 * std::cos(alpha / 2), 4 * std::sin(alpha / 2), 1.5));
   std::mt19937_64 rng(seed);
   CornerClouds clouds;
   clouds.T_ref_target = T_ref_target;

@@ -1,10 +1,11 @@
 // Algorithm 1 (thesis Sec. 4.7.4) on constructed information matrices.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
-#include <Eigen/QR>
 #include <gtest/gtest.h>
+#include <Eigen/QR>
 
 #include "mlidar/calib/convergence_monitor.hpp"
 #include "mlidar/core/rotation_average.hpp"
@@ -24,9 +25,7 @@ Mat6 random_basis(std::uint64_t seed) {
   return Eigen::HouseholderQR<Mat6>(M).householderQ();
 }
 
-Mat6 information_with(const Vec6& eigenvalues, const Mat6& basis) {
-  return basis * eigenvalues.asDiagonal() * basis.transpose();
-}
+Mat6 information_with(const Vec6& eigenvalues, const Mat6& basis) { return basis * eigenvalues.asDiagonal() * basis.transpose(); }
 
 Mat6 information_with_min(double lambda_min, std::uint64_t seed) {
   Vec6 values;
@@ -108,10 +107,11 @@ TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   std::mt19937_64 rng(3);
   std::normal_distribution<double> n(0.0, 0.01);
   int accepted = 0;
+  std::vector<SE3> good_estimates;  // the constructed inputs that must be accepted, for the expected mean below
   for (int window = 0; accepted < 25; ++window) {
     const bool good = window % 3 != 1;  // every third window is degenerate
-    const SE3 estimate(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTruth.rotation(),
-                       kTruth.translation() + Vec3(n(rng), n(rng), n(rng)));
+    const SE3 estimate(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTruth.rotation(), kTruth.translation() + Vec3(n(rng), n(rng), n(rng)));
+    if (good) good_estimates.push_back(estimate);
     const WindowVerdict v = monitor.add_window(0, estimate, information_with_min(good ? 90.0 : 40.0, 10 + window));
     EXPECT_EQ(v.accepted, good);
     accepted += good ? 1 : 0;
@@ -123,10 +123,53 @@ TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   const WindowVerdict ignored = monitor.add_window(0, SE3(), information_with_min(1000.0, 99));
   EXPECT_FALSE(ignored.accepted);  // calibration has stopped
   EXPECT_EQ(monitor.lidar(0).T_base_lidar.translation(), converged.translation());
-  const ExtrinsicMean direct = extrinsic_mean(monitor.lidar(0).accepted);
+  // The expected mean and scatter from the 25 constructed estimates, written out here (not extrinsic_mean or
+  // calibration_covariance): the translations' average; the rotations' geodesic mean by the fixed point
+  // R <- Exp(mean_i Log(R_i R^-1)) R started at the truth; deviations [t_i - t_mean, Log(R_mean^-1 R_i)].
+  ASSERT_EQ(good_estimates.size(), 25u);
+  const double count = 25.0;
+  Vec3 expected_t = Vec3::Zero();
+  for (const SE3& T : good_estimates) expected_t += T.translation();
+  expected_t /= count;
+  Quat expected_R = kTruth.rotation();
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    Vec3 step = Vec3::Zero();
+    for (const SE3& T : good_estimates) step += so3_log(T.rotation() * expected_R.conjugate());
+    expected_R = (so3_exp(step / count) * expected_R).normalized();
+  }
+  EXPECT_LT((monitor.lidar(0).T_base_lidar.translation() - expected_t).norm(), 1e-15);
+  EXPECT_LT(so3_log(monitor.lidar(0).T_base_lidar.rotation() * expected_R.conjugate()).norm(), 1e-12);
+  std::vector<Vec6> deviations;
+  Mat6 scatter = Mat6::Zero();  // sample covariance, divisor n - 1
+  for (const SE3& T : good_estimates) {
+    deviations.push_back((Vec6() << T.translation() - expected_t, so3_log(expected_R.conjugate() * T.rotation())).finished());
+    scatter += deviations.back() * deviations.back().transpose() / (count - 1.0);
+  }
+  // Integrated autocorrelation time, Geyer's initial positive sequence: rho_k the mean over the 6 axes of
+  // sum_i d_i d_i+k / (n var), var = sum_i d_i^2 / n; tau = -1 + 2 sum_m (rho_2m + rho_2m+1) while the pair is > 0,
+  // clamped to [1, n].
+  Vec6 variance = Vec6::Zero();
+  for (const Vec6& d : deviations) variance += d.cwiseAbs2() / count;
+  const auto rho = [&](std::size_t lag) {
+    double sum = 0.0;
+    for (int axis = 0; axis < 6; ++axis) {
+      double products = 0.0;
+      for (std::size_t i = 0; i + lag < deviations.size(); ++i) products += deviations[i](axis) * deviations[i + lag](axis);
+      sum += products / count / variance(axis);
+    }
+    return sum / 6.0;
+  };
+  double expected_tau = -1.0;
+  for (std::size_t m = 0; 2 * m + 1 < deviations.size(); ++m) {
+    const double pair = rho(2 * m) + rho(2 * m + 1);
+    if (!(pair > 0.0)) break;
+    expected_tau += 2.0 * pair;
+  }
+  expected_tau = std::clamp(expected_tau, 1.0, count);
+  EXPECT_NEAR(monitor.lidar(0).covariance_parts.autocorrelation_time, expected_tau, 1e-12);
   // No residual variance given: Xi_calib is the scatter term alone, the
-  // variance of the mean of 25 independent estimates (sigma^2 / 25, tau ~ 1).
-  EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(calibration_covariance(direct.local_deviations, {}, 1.0).total, 1e-12));
+  // variance of the mean of 25 estimates (S tau / 25, tau ~ 1 for independent ones).
+  EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(scatter * expected_tau / count, 1e-12));
   EXPECT_TRUE(monitor.lidar(0).covariance_parts.windows.isZero());
   EXPECT_LT(monitor.lidar(0).covariance_parts.autocorrelation_time, 3.0);
   EXPECT_LT(monitor.lidar(0).covariance.diagonal().maxCoeff(), 3.0 * 4.0 * 0.01 * 0.01 / 25);
@@ -147,11 +190,25 @@ TEST(ConvergenceMonitor, WindowCovariancesEnterXiCalibWhenTheResidualVarianceIsG
   const Mat6 information = information_with_min(100.0, 2);
   const ConvergenceMonitor monitor = converged_on_identical_windows(config, information);
   ASSERT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
-  // Identical estimates: no scatter; Xi_calib is one window's sigma^2 Lambda^-1 in the local tangent.
-  const Mat6 expected = local_covariance_from_left_information(kTruth, information, 1e-3);
+  // Identical estimates: no scatter; Xi_calib is one window's sigma^2 Lambda^-1 in the local tangent, written out:
+  // Lambda = V diag(100, 200, ..., 600) V^T, so Lambda^-1 = V diag(1/100, ..., 1/600) V^T; a left perturbation
+  // Exp(d) T reads e = M d in [t additive, r local], M = [I, -[t]x; 0, R^T].
+  const Mat6 basis = random_basis(2);
+  const Vec6 inverse_eigenvalues = (Vec6() << 1.0 / 100, 1.0 / 200, 1.0 / 300, 1.0 / 400, 1.0 / 500, 1.0 / 600).finished();
+  const Mat6 inverse_information = basis * inverse_eigenvalues.asDiagonal() * basis.transpose();
+  const Vec3 t = kTruth.translation();
+  Mat3 t_cross;
+  t_cross << 0.0, -t.z(), t.y(),  //
+      t.z(), 0.0, -t.x(),         //
+      -t.y(), t.x(), 0.0;
+  Mat6 left_to_local = Mat6::Zero();
+  left_to_local.topLeftCorner<3, 3>() = Mat3::Identity();
+  left_to_local.topRightCorner<3, 3>() = -t_cross;
+  left_to_local.bottomRightCorner<3, 3>() = kTruth.rotation().toRotationMatrix().transpose();
+  const Mat6 expected = left_to_local * (1e-3 * inverse_information) * left_to_local.transpose();
   EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(expected, 1e-9));
   EXPECT_DOUBLE_EQ(monitor.lidar(0).covariance_parts.autocorrelation_time, 4.0);  // the floor 5 clamped to n
-  EXPECT_THROW(ConvergenceMonitor({kTruth}, ConvergenceConfig{70.0, 25, 0.5}), std::invalid_argument);
+  EXPECT_THROW(ConvergenceMonitor({kTruth}, ConvergenceConfig{.min_autocorrelation_time = 0.5}), std::invalid_argument);
 }
 
 TEST(ConvergenceMonitor, SharedErrorFloorIsAddedPerAxis) {

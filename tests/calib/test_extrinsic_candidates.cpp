@@ -117,3 +117,62 @@ TEST(AverageBestCandidates, MinKeepAndEmptyInput) {
 
 }  // namespace
 }  // namespace mlidar::calib
+
+namespace mlidar::calib {
+namespace {
+
+/// A candidate that saw every direction but `weak` (a translation direction): there its value is `start`'s
+/// and its information zero, elsewhere the truth plus noise of the stated sigma.
+ExtrinsicCandidate degenerate_candidate(const SE3& start, const Vec3& weak, double sigma_t, double sigma_r, std::mt19937_64& rng) {
+  const Vec3 w = weak.normalized();
+  Vec3 t = kTruth.translation() + gaussian3(rng, sigma_t);
+  t += w * w.dot(start.translation() - t);  // the start's component along w
+  ExtrinsicCandidate c;
+  c.T_base_target = SE3(kTruth.rotation() * so3_exp(gaussian3(rng, sigma_r)), t);
+  c.degenerate = true;
+  Mat6 information = Mat6::Zero();
+  information.topLeftCorner<3, 3>() = (Mat3::Identity() - w * w.transpose()) / (sigma_t * sigma_t);
+  information.bottomRightCorner<3, 3>() = Mat3::Identity() / (sigma_r * sigma_r);
+  c.information = information;
+  return c;
+}
+
+TEST(FuseByInformation, DegenerateCandidatesWithDifferentWeakDirectionsRecoverTheTruth) {
+  std::mt19937_64 rng(11);
+  const SE3 start(kTruth.rotation() * so3_exp(Vec3(0.01, 0.0, -0.02)), kTruth.translation() + Vec3(0.4, -0.3, 0.05));
+  std::vector<ExtrinsicCandidate> candidates;
+  // Most frames along the street (weak x), a few at a turn (weak y) and on a diagonal.
+  for (int i = 0; i < 12; ++i) candidates.push_back(degenerate_candidate(start, Vec3::UnitX(), 0.005, 0.0005, rng));
+  for (int i = 0; i < 3; ++i) candidates.push_back(degenerate_candidate(start, Vec3::UnitY(), 0.005, 0.0005, rng));
+  for (int i = 0; i < 3; ++i) candidates.push_back(degenerate_candidate(start, Vec3(1.0, 1.0, 0.0), 0.005, 0.0005, rng));
+  const InformationFusion fused = fuse_by_information(candidates, start);
+  EXPECT_LT((fused.T_base_target.translation() - kTruth.translation()).norm(), 0.006);
+  EXPECT_LT(rad_to_deg(fused.T_base_target.rotation().angularDistance(kTruth.rotation())), 0.02);
+  // Each candidate is 40 cm off along its weak direction; their plain mean would be too.
+  Vec3 mean = Vec3::Zero();
+  for (const auto& c : candidates) mean += c.T_base_target.translation() / static_cast<double>(candidates.size());
+  EXPECT_GT((mean - kTruth.translation()).norm(), 0.1);
+  // x is seen by 6 of 18 candidates, y by 15, z by all: the weakest direction is x's.
+  EXPECT_GT(std::abs(fused.weak_direction.x()), 0.9);
+  EXPECT_GT(fused.translation_observability, 0.0);
+  EXPECT_LT(fused.translation_observability, 0.5);
+  // Noise as the information says: chi2 per degree of freedom near 1 (5 of 6 directions observed per candidate).
+  EXPECT_GT(fused.chi2_per_dof, 0.4);
+  EXPECT_LT(fused.chi2_per_dof, 1.6);
+}
+
+TEST(FuseByInformation, OneWeakDirectionSharedByAllStaysUnobservedAndSaysSo) {
+  std::mt19937_64 rng(12);
+  const SE3 start(kTruth.rotation(), kTruth.translation() + Vec3(0.4, 0.0, 0.0));
+  std::vector<ExtrinsicCandidate> candidates;
+  for (int i = 0; i < 10; ++i) candidates.push_back(degenerate_candidate(start, Vec3::UnitX(), 0.005, 0.0005, rng));
+  const InformationFusion fused = fuse_by_information(candidates, start);
+  EXPECT_LT(fused.translation_observability, 1e-6);
+  EXPECT_GT(std::abs(fused.weak_direction.x()), 0.99);
+  // Its variance along x is huge, so no bound on the covariance can call it calibrated.
+  EXPECT_GT(fused.covariance(0, 0), 1.0);
+  EXPECT_THROW(fuse_by_information({}, start), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mlidar::calib

@@ -27,7 +27,9 @@ std::vector<Eigen::Vector3f> scene(const Quat& R_world_lidar, bool with_ground, 
   return points;
 }
 
-double angle_deg(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / std::numbers::pi; }
+double angle_deg(const Vec3& a, const Vec3& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+}
 
 TEST(GroundUp, FindsTheGroundNormalFromAPriorSeventeenDegreesOff) {
   const Quat R_world_lidar = so3_exp(Vec3(0.7, 0.0, 0.3));  // rolled 40 deg, yawed

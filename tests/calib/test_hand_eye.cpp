@@ -8,14 +8,15 @@
 
 #include "mlidar/calib/hand_eye.hpp"
 #include "mlidar/core/so3.hpp"
+#include "pose_error.hpp"
 
 namespace mlidar::calib {
 namespace {
 
-const SE3 kTruth(so3_exp(Vec3(0.3, 3.0, 1.57)), Vec3(-2.5, 1.5, 0.4));  // thesis Fig. 3.7-like
+using test::rotation_error_rad;
+using test::translation_error_m;
 
-double rotation_error(const SE3& a, const SE3& b) { return so3_log(a.rotation().inverse() * b.rotation()).norm(); }
-double translation_error(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
+const SE3 kTruth(so3_exp(Vec3(0.3, 3.0, 1.57)), Vec3(-2.5, 1.5, 0.4));  // thesis Fig. 3.7-like
 
 Vec3 gaussian3(std::mt19937_64& rng, double sigma) {
   std::normal_distribution<double> n(0.0, sigma);
@@ -50,9 +51,7 @@ std::vector<MotionPair> planar_pairs(int count, std::uint64_t seed, double yaw_s
 std::vector<MotionPair> add_noise(std::vector<MotionPair> pairs, double sigma2, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   const double s = std::sqrt(sigma2);
-  const auto perturb = [&](const SE3& T) {
-    return SE3(so3_exp(gaussian3(rng, s)) * T.rotation(), T.translation() + gaussian3(rng, s));
-  };
+  const auto perturb = [&](const SE3& T) { return SE3(so3_exp(gaussian3(rng, s)) * T.rotation(), T.translation() + gaussian3(rng, s)); };
   for (MotionPair& p : pairs) p = {perturb(p.A), perturb(p.B)};
   return pairs;
 }
@@ -68,8 +67,8 @@ TEST(HandEye, RecoversKnownXFromExactGeneralMotion) {
   const auto pairs = general_pairs(20, 1);
   const HandEyeResult r = solve_hand_eye(pairs);
   ASSERT_EQ(r.verdict, HandEyeVerdict::ok) << r.message;
-  EXPECT_LE(rotation_error(r.T_a_b, kTruth), 1e-9);
-  EXPECT_LE(translation_error(r.T_a_b, kTruth), 1e-9);
+  EXPECT_LE(rotation_error_rad(r.T_a_b, kTruth), 1e-9);
+  EXPECT_LE(translation_error_m(r.T_a_b, kTruth), 1e-9);
   EXPECT_EQ(r.pairs_used, 20u);
   EXPECT_LT(r.singular_values[3], 1e-9 * r.singular_values[0]);  // eq 3.7 has an exact null vector
   EXPECT_GT(r.singular_values[2], 0.05 * r.singular_values[0]);
@@ -82,16 +81,15 @@ TEST(HandEye, NoisyMotionErrorsShrinkWithNoiseAndCovarianceIsConsistent) {
       const auto pairs = add_noise(general_pairs(100, seed), sigma2, 100 + seed);
       const HandEyeResult r = solve_hand_eye(pairs, permissive_filter());
       ASSERT_EQ(r.verdict, HandEyeVerdict::ok) << r.message;
-      worst_rot = std::max(worst_rot, rotation_error(r.T_a_b, kTruth));
-      worst_trans = std::max(worst_trans, translation_error(r.T_a_b, kTruth));
+      worst_rot = std::max(worst_rot, rotation_error_rad(r.T_a_b, kTruth));
+      worst_trans = std::max(worst_trans, translation_error_m(r.T_a_b, kTruth));
       // Covariance: symmetric, positive, and the rotation error within ~4 sigma.
       EXPECT_TRUE(r.covariance.isApprox(r.covariance.transpose(), 1e-9));
       EXPECT_GT(r.covariance.diagonal().minCoeff(), 0.0);
       const double rot_sigma = std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace());
-      EXPECT_LT(rotation_error(r.T_a_b, kTruth), 4.0 * rot_sigma + 1e-6);
+      EXPECT_LT(rotation_error_rad(r.T_a_b, kTruth), 4.0 * rot_sigma + 1e-6);
     }
-    std::printf("sigma2=%g, 100 pairs, 5 seeds: worst rotation error %.4f rad, translation %.4f m\n", sigma2,
-                worst_rot, worst_trans);
+    std::printf("sigma2=%g, 100 pairs, 5 seeds: worst rotation error %.4f rad, translation %.4f m\n", sigma2, worst_rot, worst_trans);
     const double sigma = std::sqrt(sigma2);
     EXPECT_LT(worst_rot, sigma);         // thesis Table 3.1: 0.01-0.07 rad
     EXPECT_LT(worst_trans, 10 * sigma);  // thesis Table 3.1: 0.28-1.44 m
@@ -115,11 +113,11 @@ TEST(HandEye, ScrewFilterRejectsInjectedOutliers) {
     EXPECT_EQ(r.screw[i].inlier, !injected) << "pair " << i;
   }
   EXPECT_EQ(r.pairs_rejected, outlier_index.size());
-  EXPECT_LE(rotation_error(r.T_a_b, kTruth), 1e-9);
-  EXPECT_LE(translation_error(r.T_a_b, kTruth), 1e-9);
+  EXPECT_LE(rotation_error_rad(r.T_a_b, kTruth), 1e-9);
+  EXPECT_LE(translation_error_m(r.T_a_b, kTruth), 1e-9);
   // Without the filter the same outliers ruin the estimate.
   const HandEyeResult unfiltered = solve_hand_eye(pairs, permissive_filter());
-  EXPECT_GT(rotation_error(unfiltered.T_a_b, kTruth) + translation_error(unfiltered.T_a_b, kTruth), 1e-3);
+  EXPECT_GT(rotation_error_rad(unfiltered.T_a_b, kTruth) + translation_error_m(unfiltered.T_a_b, kTruth), 1e-3);
 }
 
 TEST(HandEye, PlanarMotionDetectedAndSolvedUpToHeight) {
@@ -129,7 +127,7 @@ TEST(HandEye, PlanarMotionDetectedAndSolvedUpToHeight) {
   EXPECT_FALSE(r.t_z_observable);
   EXPECT_LT(r.singular_values[2], 1e-9 * r.singular_values[0]);  // two-dimensional null space
   EXPECT_NEAR(std::abs(r.planar_axis_a.z()), 1.0, 1e-12);
-  EXPECT_LE(rotation_error(r.T_a_b, kTruth), 1e-9);
+  EXPECT_LE(rotation_error_rad(r.T_a_b, kTruth), 1e-9);
   const Vec3 dt = r.T_a_b.translation() - kTruth.translation();
   EXPECT_LE(dt.head<2>().norm(), 1e-9);  // x, y recovered; z (along the axis) is not
   EXPECT_NEAR(r.T_a_b.translation().z(), 0.0, 1e-9);
@@ -141,9 +139,8 @@ TEST(HandEye, PlanarMotionWithNoise) {
   const HandEyeResult r = solve_hand_eye(pairs);
   ASSERT_EQ(r.verdict, HandEyeVerdict::planar_motion) << r.message;
   const Vec3 dt = r.T_a_b.translation() - kTruth.translation();
-  std::printf("planar, sigma2=1e-6: rotation error %.5f rad, x-y error %.5f m\n", rotation_error(r.T_a_b, kTruth),
-              dt.head<2>().norm());
-  EXPECT_LT(rotation_error(r.T_a_b, kTruth), 0.005);
+  std::printf("planar, sigma2=1e-6: rotation error %.5f rad, x-y error %.5f m\n", rotation_error_rad(r.T_a_b, kTruth), dt.head<2>().norm());
+  EXPECT_LT(rotation_error_rad(r.T_a_b, kTruth), 0.005);
   EXPECT_LT(dt.head<2>().norm(), 0.02);
 }
 
@@ -179,8 +176,8 @@ TEST(HandEye, PairOrderDoesNotMatter) {
   const HandEyeResult forward = solve_hand_eye(pairs, permissive_filter());
   std::shuffle(pairs.begin(), pairs.end(), std::mt19937_64(10));
   const HandEyeResult shuffled = solve_hand_eye(pairs, permissive_filter());
-  EXPECT_LE(rotation_error(forward.T_a_b, shuffled.T_a_b), 1e-9);
-  EXPECT_LE(translation_error(forward.T_a_b, shuffled.T_a_b), 1e-9);
+  EXPECT_LE(rotation_error_rad(forward.T_a_b, shuffled.T_a_b), 1e-9);
+  EXPECT_LE(translation_error_m(forward.T_a_b, shuffled.T_a_b), 1e-9);
 }
 
 TEST(HandEye, RejectsBadConfig) {

@@ -10,15 +10,16 @@
 
 #include "mlidar/calib/online_hand_eye.hpp"
 #include "mlidar/core/so3.hpp"
+#include "pose_error.hpp"
 
 namespace mlidar::calib {
 namespace {
 
+using test::rotation_error_rad;
+
 const SE3 kTruth(so3_exp(Vec3(0.3, -0.4, 1.2)), Vec3(-0.5, 0.3, 0.4));  // T_base_lidar
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-double rotation_error(const SE3& a, const SE3& b) { return so3_log(a.rotation().inverse() * b.rotation()).norm(); }
 
 Vec3 gaussian3(std::mt19937_64& rng, double sigma) {
   std::normal_distribution<double> n(0.0, sigma);
@@ -64,7 +65,7 @@ TEST(OnlineHandEye, RecoversXFromExactPairs) {
   EXPECT_GT(s.singular_values[2], 0.25);
   EXPECT_LT(s.singular_values[3], 1e-9 * s.singular_values[0]);  // an exact null vector
   EXPECT_FALSE(s.planar_motion);
-  EXPECT_LE(rotation_error(s.T_base_lidar, kTruth), 1e-9);
+  EXPECT_LE(rotation_error_rad(s.T_base_lidar, kTruth), 1e-9);
   EXPECT_LE((s.T_base_lidar.translation() - kTruth.translation()).norm(), 1e-9);
   EXPECT_EQ(s.pairs_stored, 40u);
   EXPECT_EQ(s.pairs_seen, 40u);
@@ -91,7 +92,7 @@ TEST(OnlineHandEye, SeededNoisyPairsGiveAnAccurateEstimate) {
   for (const MotionPair& p : pairs) online.add(perturb(p, rng, 0.002, 0.005));
   const OnlineHandEyeStatus& s = online.status();
   ASSERT_EQ(s.state, OnlineHandEyeState::ready);
-  EXPECT_LT(rotation_error(s.T_base_lidar, kTruth), 0.5 * kDeg);
+  EXPECT_LT(rotation_error_rad(s.T_base_lidar, kTruth), 0.5 * kDeg);
   EXPECT_LT((s.T_base_lidar.translation() - kTruth.translation()).norm(), 0.02);
   EXPECT_GT(s.rotation_rms_rad, 0.0);
 }
@@ -105,8 +106,8 @@ TEST(OnlineHandEye, HuberWeightsReduceTheEffectOfGrossOutliers) {
   }
   OnlineHandEyeConfig unweighted;
   unweighted.huber_delta_rad = 10.0;  // every residual inside delta: weight 1
-  const double robust = rotation_error(fed(pairs).status().T_base_lidar, kTruth);
-  const double plain = rotation_error(fed(pairs, unweighted).status().T_base_lidar, kTruth);
+  const double robust = rotation_error_rad(fed(pairs).status().T_base_lidar, kTruth);
+  const double plain = rotation_error_rad(fed(pairs, unweighted).status().T_base_lidar, kTruth);
   EXPECT_LT(robust, 0.5 * plain);
   EXPECT_LT(robust, 1.0 * kDeg);
 }
@@ -127,8 +128,8 @@ TEST(OnlineHandEye, SingleAxisRotationStaysCollecting) {
   for (int k = 0; k < 300; ++k) online.add(exact_pair(n(rng) * axis, gaussian3(rng, 1.0)));
   const OnlineHandEyeStatus& s = online.status();
   EXPECT_EQ(s.state, OnlineHandEyeState::collecting);
-  EXPECT_GT(s.singular_values[1], 1.0);        // the rotation itself is well excited...
-  EXPECT_LT(s.singular_values[2], 1e-9);       // ...but the rotation about the axis is not
+  EXPECT_GT(s.singular_values[1], 1.0);   // the rotation itself is well excited...
+  EXPECT_LT(s.singular_values[2], 1e-9);  // ...but the rotation about the axis is not
 }
 
 TEST(OnlineHandEye, PlanarMotionFlagsTheAxisAndFixesItsTranslationToZero) {
@@ -142,7 +143,7 @@ TEST(OnlineHandEye, PlanarMotionFlagsTheAxisAndFixesItsTranslationToZero) {
   ASSERT_EQ(s.state, OnlineHandEyeState::ready);
   EXPECT_TRUE(s.planar_motion);
   EXPECT_GT(s.unobservable_axis_base.z(), 0.99);
-  EXPECT_LE(rotation_error(s.T_base_lidar, kTruth), 1e-9);
+  EXPECT_LE(rotation_error_rad(s.T_base_lidar, kTruth), 1e-9);
   const Vec3& axis = s.unobservable_axis_base;
   EXPECT_NEAR(s.T_base_lidar.translation().dot(axis), 0.0, 1e-12);
   const Vec3 observable_truth = kTruth.translation() - axis * axis.dot(kTruth.translation());
@@ -161,8 +162,7 @@ TEST(OnlineHandEye, BoundedStoreKeepsTheLargestRotations) {
     const double angle = 0.01 * ((k * 7) % 30 + 1);  // a permutation of 0.01 .. 0.30
     const Vec3 axis = gaussian3(rng, 1.0).normalized();
     pairs.push_back(exact_pair(angle * axis, gaussian3(rng, 1.0)));
-    const double smallest_stored =
-        angles.size() < 10 ? 0.0 : *std::min_element(angles.begin(), angles.end());
+    const double smallest_stored = angles.size() < 10 ? 0.0 : *std::min_element(angles.begin(), angles.end());
     const PairOutcome outcome = online.add(pairs.back());
     if (angles.size() < 10) {
       EXPECT_EQ(outcome, PairOutcome::stored);
@@ -221,7 +221,7 @@ TEST(OnlineHandEye, PairsWithInvalidTranslationGiveRotationOnly) {
   }
   ASSERT_EQ(flagged.status().state, OnlineHandEyeState::ready);
   EXPECT_EQ(flagged.status().pairs_translation, 15u);
-  EXPECT_LE(rotation_error(flagged.status().T_base_lidar, kTruth), 1e-9);
+  EXPECT_LE(rotation_error_rad(flagged.status().T_base_lidar, kTruth), 1e-9);
   EXPECT_LE((flagged.status().T_base_lidar.translation() - kTruth.translation()).norm(), 1e-9);
   EXPECT_LT(flagged.status().translation_std_m, 1e-6);
   // The same pairs all used: the translation is off and its predicted std says so.
@@ -259,7 +259,7 @@ TEST(OnlineHandEye, PlanarRotationStartsFromTranslationsWithTheAxisFlagged) {
   EXPECT_TRUE(s.planar_motion);
   EXPECT_TRUE(s.planar_rotation);
   EXPECT_GT(s.unobservable_axis_base.z(), 0.999);
-  EXPECT_LE(rotation_error(s.T_base_lidar, kTruth), 1e-6);
+  EXPECT_LE(rotation_error_rad(s.T_base_lidar, kTruth), 1e-6);
   EXPECT_NEAR(s.T_base_lidar.translation().z(), 0.0, 1e-9);
   EXPECT_LE((s.T_base_lidar.translation().head<2>() - kTruth.translation().head<2>()).norm(), 1e-6);
   // Pure yaw without translation leaves the rotation about z unobservable: no start.

@@ -66,8 +66,8 @@ TEST(PairRefineNees, ReportedCovarianceIsConsistentOverSeededPairs) {
   }
   std::cout << "mean NEES over " << kPairs << " pairs: reported " << sum / kPairs << ", ICP alone " << sum_icp / kPairs
             << " (consistent: 6)\n";
-  EXPECT_GT(sum, kChi2Low);  // not over-cautious
-  EXPECT_LT(sum, kChi2High);  // not over-confident
+  EXPECT_GT(sum, kChi2Low);       // not over-cautious
+  EXPECT_LT(sum, kChi2High);      // not over-confident
   EXPECT_GT(sum_icp, kChi2High);  // the ICP's own covariance alone is over-confident (why the term exists)
 }
 

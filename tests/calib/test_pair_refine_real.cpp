@@ -18,6 +18,7 @@
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/opencalib.hpp"
+#include "pose_error.hpp"
 #include "test_support.hpp"
 
 namespace mlidar::test {
@@ -25,7 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kAgreeDeg = 0.3;  // perturbed guess vs initial guess, same scene
+constexpr double kAgreeDeg = 0.3;   // perturbed guess vs initial guess, same scene
 constexpr double kScenesDeg = 0.3;  // across scenes: the criterion (see ThreeScenesAgree)
 constexpr double kAgreeM = 0.05;
 constexpr double kChi2Six99 = 16.81;  // chi-square, 6 dof, 0.99 quantile
@@ -45,9 +46,7 @@ int device_of(const std::map<int, fs::path>& clouds, const std::string& name) {
   return -1;
 }
 
-std::vector<Eigen::Vector3f> points_of(const fs::path& file) {
-  return io::to_scan(io::read_cloud(file).table, file.string()).points;
-}
+std::vector<Eigen::Vector3f> points_of(const fs::path& file) { return io::to_scan(io::read_cloud(file).table, file.string()).points; }
 
 struct SceneClouds {
   std::vector<Eigen::Vector3f> top, left, right;
@@ -79,19 +78,15 @@ calib::PairRefineResult refine(const std::string& scene, const std::string& side
   return calib::refine_pair(c.top, left ? c.left : c.right, guess_of(init_file, left ? c.left_id : c.right_id));
 }
 
-void print(const std::string& scene, const std::string& side, const std::string& init,
-           const calib::PairRefineResult& r) {
+void print(const std::string& scene, const std::string& side, const std::string& init, const calib::PairRefineResult& r) {
   const Vec3 rpy = rpy_deg_from_quat(r.T_ref_target.rotation());
   const Vec3& t = r.T_ref_target.translation();
-  std::cout << scene << ' ' << side << ' ' << init << ' ' << to_string(r.verdict) << " rpy " << rpy.transpose()
-            << " t " << t.transpose() << " rmse " << r.rmse << " overlap " << r.overlap.fraction_b << " omega "
-            << r.overlap.omega() << " sd " << r.rotation_sd_deg << " deg " << r.translation_sd_m << " m, start "
-            << r.chosen_start;
+  std::cout << scene << ' ' << side << ' ' << init << ' ' << to_string(r.verdict) << " rpy " << rpy.transpose() << " t " << t.transpose()
+            << " rmse " << r.rmse << " overlap " << r.overlap.fraction_b << " omega " << r.overlap.omega() << " sd " << r.rotation_sd_deg
+            << " deg " << r.translation_sd_m << " m, start " << r.chosen_start;
   for (const auto& reason : r.reasons) std::cout << " [" << reason << ']';
   std::cout << '\n';
 }
-
-double rotation_deg(const SE3& a, const SE3& b) { return rad_to_deg(so3_log(a.rotation().inverse() * b.rotation()).norm()); }
 
 /// The refined answer of every scene and side from initial_extrinsic.txt, computed once.
 const calib::PairRefineResult& initial_answer(const std::string& scene, const std::string& side) {
@@ -113,7 +108,7 @@ Spread max_pairwise(const std::vector<SE3>& poses) {
   Spread spread;
   for (std::size_t i = 0; i < poses.size(); ++i)
     for (std::size_t j = i + 1; j < poses.size(); ++j) {
-      spread.deg = std::max(spread.deg, rotation_deg(poses[i], poses[j]));
+      spread.deg = std::max(spread.deg, rotation_error_deg(poses[i], poses[j]));
       spread.m = std::max(spread.m, (poses[i].translation() - poses[j].translation()).norm());
     }
   return spread;
@@ -148,8 +143,8 @@ TEST_P(RealPairRefine, ThreeScenesAgree) {
       const Vec6 d = difference(a.T_ref_target, b.T_ref_target);
       const double nees = d.dot((a.covariance + b.covariance).ldlt().solve(d));
       const double nees_icp = d.dot((a.covariance_icp + b.covariance_icp).ldlt().solve(d));
-      std::cout << side << ' ' << kScenes[i] << '-' << kScenes[j] << " NEES of the difference " << nees
-                << " (ICP covariance alone " << nees_icp << ")\n";
+      std::cout << side << ' ' << kScenes[i] << '-' << kScenes[j] << " NEES of the difference " << nees << " (ICP covariance alone "
+                << nees_icp << ")\n";
       EXPECT_LT(nees, kChi2Six99) << side << ' ' << kScenes[i] << '-' << kScenes[j];
     }
   const Spread spread = max_pairwise(answers);
@@ -173,7 +168,7 @@ TEST_P(RealPairRefine, PerturbedGuessesReachTheSameAnswerOrSayNot) {
       continue;
     }
     const SE3& answer = initial_answer(scene, side).T_ref_target;
-    EXPECT_LT(rotation_deg(r.T_ref_target, answer), kAgreeDeg) << scene << ' ' << side;
+    EXPECT_LT(rotation_error_deg(r.T_ref_target, answer), kAgreeDeg) << scene << ' ' << side;
     EXPECT_LT((r.T_ref_target.translation() - answer.translation()).norm(), kAgreeM) << scene << ' ' << side;
   }
 }

@@ -1,18 +1,19 @@
 // Simulated: one street scene seen by two LiDARs of a rig with a known
 // T_ref_target (the oracle). Refinement from a slightly wrong guess recovers
-// it; from a guess tens of degrees off the search recovers it or the verdict
-// says not converged. Also unit properties of the building blocks.
+// it; from a guess tens of degrees off the search recovers it; unrelated
+// clouds are not converged. Also unit properties of the building blocks.
 #include <cmath>
 #include <random>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "mlidar/calib/pair_refine.hpp"
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/sim/acquisition.hpp"
 #include "mlidar/sim/lidar_models.hpp"
 #include "mlidar/sim/scenes.hpp"
+#include "pose_error.hpp"
 
 namespace mlidar::test {
 namespace {
@@ -42,9 +43,6 @@ const SimPair& sim_pair() {
   return pair;
 }
 
-double rotation_error_deg(const SE3& a, const SE3& b) { return rad_to_deg(so3_log(a.rotation().inverse() * b.rotation()).norm()); }
-double translation_error_m(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
-
 TEST(PairRefineSim, SmallPerturbationRecoversTruth) {
   const SimPair& pair = sim_pair();
   std::mt19937_64 rng(7);
@@ -65,20 +63,21 @@ TEST(PairRefineSim, SmallPerturbationRecoversTruth) {
   }
 }
 
-TEST(PairRefineSim, BadGuessIsSearchedOrReported) {
+TEST(PairRefineSim, BadGuessIsSearchedAndConverges) {
+  // 20 deg of roll and 40 deg of yaw off: ICP from the guess fails its checks, the multi-start search
+  // finds the truth (measured on this scene: searched_and_converged). A not_converged verdict here is a
+  // regression of the search, not an acceptable answer.
   const SimPair& pair = sim_pair();
   const SE3 T_init = SE3(quat_from_rpy_deg(Vec3(20.0, 0.0, 40.0)), Vec3(0.1, -0.1, 0.1)) * pair.T_ref_target;
   const calib::PairRefineResult r = calib::refine_pair(pair.ref, pair.target, T_init);
   EXPECT_TRUE(r.searched);
   EXPECT_FALSE(r.starts.empty());
-  if (r.verdict == calib::PairVerdict::kNotConverged) {
-    EXPECT_FALSE(r.reasons.empty());
-    std::string why;
-    for (const std::string& reason : r.reasons) why += " [" + reason + "]";
-    GTEST_SKIP() << "search did not converge and said so:" << why << " best start " << r.chosen_start << " err "
-                 << rotation_error_deg(r.T_ref_target, pair.T_ref_target) << " deg";
-  }
-  EXPECT_EQ(r.verdict, calib::PairVerdict::kSearchedAndConverged);
+  std::string why;
+  for (const std::string& reason : r.reasons) why += " [" + reason + "]";
+  EXPECT_EQ(r.verdict, calib::PairVerdict::kSearchedAndConverged)
+      << calib::to_string(r.verdict) << ", reasons:" << why << ", best start " << r.chosen_start;
+  EXPECT_TRUE(r.reasons.empty()) << why;
+  EXPECT_NE(r.chosen_start, "init");
   EXPECT_LT(rotation_error_deg(r.T_ref_target, pair.T_ref_target), 0.1);
   EXPECT_LT(translation_error_m(r.T_ref_target, pair.T_ref_target), 0.01);
 }
@@ -95,8 +94,7 @@ TEST(PairRefineSim, UnrelatedCloudsAreNotConverged) {
 }
 
 TEST(PairRefineParts, VoxelDownsampleKeepsCentroidsAndDropsNonFinite) {
-  const std::vector<Eigen::Vector3f> points{{0.1F, 0.1F, 0.1F}, {0.3F, 0.3F, 0.3F}, {1.5F, 0.0F, 0.0F},
-                                            {NAN, 0.0F, 0.0F}};
+  const std::vector<Eigen::Vector3f> points{{0.1F, 0.1F, 0.1F}, {0.3F, 0.3F, 0.3F}, {1.5F, 0.0F, 0.0F}, {NAN, 0.0F, 0.0F}};
   const auto out = calib::voxel_downsample(points, 1.0);
   ASSERT_EQ(out.size(), 2u);
   EXPECT_TRUE(out[0].isApprox(Eigen::Vector3f(0.2F, 0.2F, 0.2F)));

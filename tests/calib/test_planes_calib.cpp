@@ -11,6 +11,7 @@
 #include "mlidar/calib/planes_calibrator.hpp"
 #include "mlidar/calib/planes_refine.hpp"
 #include "mlidar/core/error.hpp"
+#include "pose_error.hpp"
 
 namespace mlidar::test {
 namespace {
@@ -19,17 +20,13 @@ using calib::PlanesCalibrator;
 using calib::PlanesConfig;
 using calib::PlanesWarning;
 
-double rotation_error(const SE3& a, const SE3& b) { return so3_log(a.rotation().conjugate() * b.rotation()).norm(); }
-double translation_error(const SE3& a, const SE3& b) { return (a.translation() - b.translation()).norm(); }
-
 /// The three corner planes of the fixture in a LiDAR frame, unordered.
 std::array<Plane, 3> world_planes_in(const SE3& T_world_lidar, double alpha) {
   const std::array<Plane, 3> world{Plane{Vec3(0, 1, 0), 0.0}, Plane{Vec3(std::sin(alpha), -std::cos(alpha), 0), 0.0},
                                    Plane{Vec3(0, 0, 1), 0.0}};
   std::array<Plane, 3> out;
   for (int i = 0; i < 3; ++i) {  // n_w.(R p + t) + d = (R^T n_w).p + n_w.t + d
-    out[i] = {T_world_lidar.rotation().conjugate() * world[i].normal,
-              world[i].normal.dot(T_world_lidar.translation()) + world[i].offset};
+    out[i] = {T_world_lidar.rotation().conjugate() * world[i].normal, world[i].normal.dot(T_world_lidar.translation()) + world[i].offset};
   }
   return out;
 }
@@ -48,8 +45,8 @@ TEST(PlanesClosedForm, ExactPlanesGiveTheExactTransform) {
     calib::orient_and_order(ref, Vec3::UnitZ());
     calib::orient_and_order(target, Vec3::UnitZ());
     const SE3 estimate = calib::closed_form_T_ref_target(ref, target);
-    EXPECT_LT(rotation_error(estimate, truth), 1e-9);
-    EXPECT_LT(translation_error(estimate, truth), 1e-9);
+    EXPECT_LT(rotation_error_rad(estimate, truth), 1e-9);
+    EXPECT_LT(translation_error_m(estimate, truth), 1e-9);
   }
 }
 
@@ -102,8 +99,8 @@ TEST(PlanesRefine, NoiseFreePointsStayAtTheTruth) {
   problem.T_ref_target = SE3(truth.rotation() * so3_exp(Vec3(0.02, -0.01, 0.03)), truth.translation() + Vec3(0.1, 0, -0.05));
   const calib::RefineResult result = calib::refine_planes(problem, {0.1, 100});
   EXPECT_TRUE(result.converged);
-  EXPECT_LT(rotation_error(result.T_ref_target, truth), 1e-9);
-  EXPECT_LT(translation_error(result.T_ref_target, truth), 1e-9);
+  EXPECT_LT(rotation_error_rad(result.T_ref_target, truth), 1e-9);
+  EXPECT_LT(translation_error_m(result.T_ref_target, truth), 1e-9);
 }
 
 TEST(PlanesCalibrator, NoiseFreeCloudsRecoverTheTransformToFloatPrecision) {
@@ -111,8 +108,8 @@ TEST(PlanesCalibrator, NoiseFreeCloudsRecoverTheTransformToFloatPrecision) {
     const CornerClouds clouds = make_corner(70.0, thesis_configuration(configuration), 3000, 0, 0.0, 11);
     const auto result = PlanesCalibrator(PlanesConfig{}).calibrate(clouds.ref, clouds.target, std::nullopt, "ref", "target");
     // Points are stored as float (7 significant digits over ~10 m), so 1e-5 is the floor here.
-    EXPECT_LT(rotation_error(result.T_ref_target, clouds.T_ref_target), 1e-5);
-    EXPECT_LT(translation_error(result.T_ref_target, clouds.T_ref_target), 1e-5);
+    EXPECT_LT(rotation_error_rad(result.T_ref_target, clouds.T_ref_target), 1e-5);
+    EXPECT_LT(translation_error_m(result.T_ref_target, clouds.T_ref_target), 1e-5);
     EXPECT_TRUE(result.ok());
   }
 }
@@ -128,15 +125,15 @@ TEST(PlanesCalibrator, ShuffledPointsGiveTheSameResult) {
   std::shuffle(target.begin(), target.end(), rng);
   const auto second = calibrator.calibrate(target, ref, std::nullopt, "ref", "target");  // swapped roles too
   const SE3 back = second.T_ref_target.inverse();
-  EXPECT_LT(rotation_error(first.T_ref_target, back), 1e-3);
-  EXPECT_LT(translation_error(first.T_ref_target, back), 1e-2);
+  EXPECT_LT(rotation_error_rad(first.T_ref_target, back), 1e-3);
+  EXPECT_LT(translation_error_m(first.T_ref_target, back), 1e-2);
   const auto third = calibrator.calibrate(ref, target, std::nullopt, "ref", "target");
   // Another RANSAC draw may keep a handful of different points at the band's
   // edge: the answers agree far inside their own standard deviation.
   const double sigma_r = std::sqrt(first.covariance.bottomRightCorner<3, 3>().trace());
   const double sigma_t = std::sqrt(first.covariance.topLeftCorner<3, 3>().trace());
-  EXPECT_LT(rotation_error(first.T_ref_target, third.T_ref_target), 0.1 * sigma_r);
-  EXPECT_LT(translation_error(first.T_ref_target, third.T_ref_target), 0.1 * sigma_t);
+  EXPECT_LT(rotation_error_rad(first.T_ref_target, third.T_ref_target), 0.1 * sigma_r);
+  EXPECT_LT(translation_error_m(first.T_ref_target, third.T_ref_target), 0.1 * sigma_t);
 }
 
 TEST(PlanesCalibrator, GuessPicksTheMatchingWhenTheUpAxisIsWrong) {
@@ -145,8 +142,8 @@ TEST(PlanesCalibrator, GuessPicksTheMatchingWhenTheUpAxisIsWrong) {
   config.up = Vec3::UnitX();  // the floor heuristic now picks a wall
   const SE3 guess(clouds.T_ref_target.rotation() * so3_exp(Vec3(0.1, -0.1, 0.1)), Vec3::Zero());
   const auto result = PlanesCalibrator(config).calibrate(clouds.ref, clouds.target, guess, "ref", "target");
-  EXPECT_LT(rotation_error(result.T_ref_target, clouds.T_ref_target), 0.01);
-  EXPECT_LT(translation_error(result.T_ref_target, clouds.T_ref_target), 0.02);
+  EXPECT_LT(rotation_error_rad(result.T_ref_target, clouds.T_ref_target), 0.01);
+  EXPECT_LT(translation_error_m(result.T_ref_target, clouds.T_ref_target), 0.02);
 }
 
 TEST(PlanesCalibrator, CloudsWithoutACornerAreRejectedByName) {

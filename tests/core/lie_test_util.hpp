@@ -5,6 +5,7 @@
 #include <random>
 
 #include "mlidar/core/se3.hpp"
+#include "pose_error.hpp"
 
 namespace mlidar::test {
 
@@ -16,8 +17,7 @@ inline Vec3 random_unit_vector(std::mt19937& rng) {
 
 /// Rotation vector with angle uniform in [min_angle, max_angle] (log-uniform
 /// when log_scale is set, for tiny angles) and a random axis.
-inline Vec3 random_rotation_vector(std::mt19937& rng, double min_angle, double max_angle,
-                                   bool log_scale = false) {
+inline Vec3 random_rotation_vector(std::mt19937& rng, double min_angle, double max_angle, bool log_scale = false) {
   double angle = 0.0;
   if (log_scale) {
     std::uniform_real_distribution<double> exponent(std::log(min_angle), std::log(max_angle));
@@ -36,19 +36,10 @@ inline Vec6 random_twist(std::mt19937& rng, double min_angle, double max_angle, 
   return xi;
 }
 
-inline SE3 random_pose(std::mt19937& rng) {
-  return SE3::exp(random_twist(rng, 0.0, std::numbers::pi));
-}
-
-/// Geodesic distance between two rotations (rad).
-inline double rotation_distance(const Quat& a, const Quat& b) {
-  return so3_log(a.conjugate() * b).norm();
-}
+inline SE3 random_pose(std::mt19937& rng) { return SE3::exp(random_twist(rng, 0.0, std::numbers::pi)); }
 
 /// Max-abs difference of two poses' 4x4 matrices.
-inline double pose_distance(const SE3& a, const SE3& b) {
-  return (a.matrix() - b.matrix()).cwiseAbs().maxCoeff();
-}
+inline double pose_distance(const SE3& a, const SE3& b) { return (a.matrix() - b.matrix()).cwiseAbs().maxCoeff(); }
 
 /// Central differences of a map R^n -> R^m: column j is (f(x + h e_j) - f(x - h e_j)) / 2h.
 template <int M, int N, typename F>

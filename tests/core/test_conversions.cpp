@@ -13,7 +13,7 @@
 namespace mlidar {
 namespace {
 
-using test::rotation_distance;
+using test::rotation_error_rad;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -30,8 +30,8 @@ TEST(Conversions, WxyzRoundTripAndSign) {
     const Vec4 wxyz = quat_to_wxyz(q);
     EXPECT_GE(wxyz(0), 0.0);
     EXPECT_NEAR(wxyz.norm(), 1.0, 1e-15);
-    EXPECT_LT(rotation_distance(quat_from_wxyz(wxyz), q), 1e-14);
-    EXPECT_LT(rotation_distance(quat_from_wxyz(-3.0 * wxyz), q), 1e-14);  // scale and sign free
+    EXPECT_LT(rotation_error_rad(quat_from_wxyz(wxyz), q), 1e-14);
+    EXPECT_LT(rotation_error_rad(quat_from_wxyz(-3.0 * wxyz), q), 1e-14);  // scale and sign free
   }
   // Field order: w first. [0, 0, 0, 1] is a half turn about z.
   EXPECT_LT((quat_from_wxyz(Vec4(0, 0, 0, 1)) * Vec3::UnitX() - Vec3(-1, 0, 0)).norm(), 1e-15);
@@ -58,9 +58,8 @@ TEST(Conversions, RpyFollowsTheThesisConvention) {
   std::uniform_real_distribution<double> angle(-kPi, kPi);
   for (int i = 0; i < 200; ++i) {
     const Vec3 rpy(angle(rng), angle(rng) / 2.0, angle(rng));
-    const Quat expected = so3_exp(rpy.z() * Vec3::UnitZ()) * so3_exp(rpy.y() * Vec3::UnitY()) *
-                          so3_exp(rpy.x() * Vec3::UnitX());
-    EXPECT_LT(rotation_distance(quat_from_rpy(rpy), expected), 1e-14);
+    const Quat expected = so3_exp(rpy.z() * Vec3::UnitZ()) * so3_exp(rpy.y() * Vec3::UnitY()) * so3_exp(rpy.x() * Vec3::UnitX());
+    EXPECT_LT(rotation_error_rad(quat_from_rpy(rpy), expected), 1e-14);
   }
   // yaw 90 deg takes x to y; pitch 90 deg takes x to -z; roll 90 deg takes y to z.
   EXPECT_LT((quat_from_rpy_deg(Vec3(0, 0, 90)) * Vec3::UnitX() - Vec3::UnitY()).norm(), 1e-15);
@@ -91,7 +90,7 @@ TEST(Conversions, RpyNearGimbalLockRebuildsTheRotation) {
         const Vec3 rpy(angle(rng), side * (kPi / 2.0 - gap), angle(rng));
         const Quat q = quat_from_rpy(rpy);
         const Vec3 back = rpy_from_quat(q);
-        EXPECT_LT(rotation_distance(quat_from_rpy(back), q), 1e-13) << "gap " << gap;
+        EXPECT_LT(rotation_error_rad(quat_from_rpy(back), q), 1e-13) << "gap " << gap;
         EXPECT_NEAR(back.y(), rpy.y(), 1e-13) << "gap " << gap;
         EXPECT_LE(std::abs(back.y()), kPi / 2.0);
         if (gap >= 1e-3) {

@@ -15,7 +15,7 @@ namespace {
 using test::pose_distance;
 using test::random_pose;
 using test::random_twist;
-using test::rotation_distance;
+using test::rotation_error_rad;
 
 TEST(Slerp, MatchesEigenSlerpAndEndpoints) {
   std::mt19937 rng(31);
@@ -24,9 +24,9 @@ TEST(Slerp, MatchesEigenSlerpAndEndpoints) {
     const Quat a = so3_exp(test::random_rotation_vector(rng, 0.0, 3.1));
     const Quat b = so3_exp(test::random_rotation_vector(rng, 0.0, 3.1));
     const double s = fraction(rng);
-    EXPECT_LT(rotation_distance(so3_slerp(a, b, s), a.slerp(s, b)), 1e-12);
-    EXPECT_LT(rotation_distance(so3_slerp(a, b, 0.0), a), 1e-14);
-    EXPECT_LT(rotation_distance(so3_slerp(a, b, 1.0), b), 1e-14);
+    EXPECT_LT(rotation_error_rad(so3_slerp(a, b, s), a.slerp(s, b)), 1e-12);
+    EXPECT_LT(rotation_error_rad(so3_slerp(a, b, 0.0), a), 1e-14);
+    EXPECT_LT(rotation_error_rad(so3_slerp(a, b, 1.0), b), 1e-14);
   }
 }
 
@@ -37,7 +37,7 @@ TEST(Slerp, ConstantAngularVelocity) {
     const Vec3 omega = test::random_rotation_vector(rng, 0.0, 3.0);
     const Quat b = a * so3_exp(omega);
     for (const double s : {0.25, 0.5, 0.75}) {
-      EXPECT_LT(rotation_distance(so3_slerp(a, b, s), a * so3_exp(s * omega)), 1e-12);
+      EXPECT_LT(rotation_error_rad(so3_slerp(a, b, s), a * so3_exp(s * omega)), 1e-12);
     }
   }
 }
@@ -102,8 +102,7 @@ TEST(TrajectoryInterpolation, ReproducesConstantTwistMotion) {
 
 TEST(TrajectoryInterpolation, OutOfRangeGivesNullopt) {
   std::mt19937 rng(36);
-  const Trajectory trajectory = constant_twist_trajectory(random_pose(rng), random_twist(rng, 0.0, 1.0),
-                                                          {1.0, 2.0, 3.0});
+  const Trajectory trajectory = constant_twist_trajectory(random_pose(rng), random_twist(rng, 0.0, 1.0), {1.0, 2.0, 3.0});
   EXPECT_FALSE(interpolate_pose(trajectory, 0.999999).has_value());
   EXPECT_FALSE(interpolate_pose(trajectory, 3.000001).has_value());
   EXPECT_FALSE(interpolate_pose(trajectory, std::numeric_limits<double>::quiet_NaN()).has_value());

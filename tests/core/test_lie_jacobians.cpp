@@ -19,8 +19,7 @@ constexpr double kPi = std::numbers::pi;
 
 // Angles that exercise zero, the Taylor branches (< 1e-2), both sides of the
 // switch, ordinary angles and the neighbourhood of pi.
-const std::vector<double> kAngles = {0.0, 1e-12, 1e-8, 1e-5, 1e-3, 0.0099, 0.0101, 0.3, 1.0, 2.0, 3.0,
-                                     kPi - 1e-6};
+const std::vector<double> kAngles = {0.0, 1e-12, 1e-8, 1e-5, 1e-3, 0.0099, 0.0101, 0.3, 1.0, 2.0, 3.0, kPi - 1e-6};
 
 // J_l: Log(Exp(phi + d) Exp(phi)^-1) ~= J_l d;  J_r: Log(Exp(phi)^-1 Exp(phi + d)) ~= J_r d.
 Mat3 numeric_so3_left(const Vec3& phi) {
@@ -56,10 +55,8 @@ TEST(SO3Jacobian, InversesAreInverses) {
   for (const double angle : kAngles) {
     for (int i = 0; i < 10; ++i) {
       const Vec3 phi = angle * random_unit_vector(rng);
-      EXPECT_LT((so3_left_jacobian(phi) * so3_left_jacobian_inverse(phi) - Mat3::Identity()).norm(), 1e-13)
-          << "angle " << angle;
-      EXPECT_LT((so3_right_jacobian(phi) * so3_right_jacobian_inverse(phi) - Mat3::Identity()).norm(), 1e-13)
-          << "angle " << angle;
+      EXPECT_LT((so3_left_jacobian(phi) * so3_left_jacobian_inverse(phi) - Mat3::Identity()).norm(), 1e-13) << "angle " << angle;
+      EXPECT_LT((so3_right_jacobian(phi) * so3_right_jacobian_inverse(phi) - Mat3::Identity()).norm(), 1e-13) << "angle " << angle;
     }
   }
 }
@@ -95,10 +92,8 @@ TEST(SE3Jacobian, InversesAreInverses) {
     for (int i = 0; i < 10; ++i) {
       Vec6 xi;
       xi << unit(rng), unit(rng), unit(rng), angle * random_unit_vector(rng);
-      EXPECT_LT((se3_left_jacobian(xi) * se3_left_jacobian_inverse(xi) - Mat6::Identity()).norm(), 1e-12)
-          << "xi " << xi.transpose();
-      EXPECT_LT((se3_right_jacobian(xi) * se3_right_jacobian_inverse(xi) - Mat6::Identity()).norm(), 1e-12)
-          << "xi " << xi.transpose();
+      EXPECT_LT((se3_left_jacobian(xi) * se3_left_jacobian_inverse(xi) - Mat6::Identity()).norm(), 1e-12) << "xi " << xi.transpose();
+      EXPECT_LT((se3_right_jacobian(xi) * se3_right_jacobian_inverse(xi) - Mat6::Identity()).norm(), 1e-12) << "xi " << xi.transpose();
     }
   }
 }
@@ -110,8 +105,7 @@ TEST(SE3Jacobian, LeftRightRelation) {
   for (const double angle : kAngles) {
     Vec6 xi;
     xi << unit(rng), unit(rng), unit(rng), angle * random_unit_vector(rng);
-    EXPECT_LT((se3_left_jacobian(xi) - SE3::exp(xi).adjoint() * se3_right_jacobian(xi)).norm(), 1e-12)
-        << "angle " << angle;
+    EXPECT_LT((se3_left_jacobian(xi) - SE3::exp(xi).adjoint() * se3_right_jacobian(xi)).norm(), 1e-12) << "angle " << angle;
     EXPECT_LT((se3_left_jacobian(xi) * xi - xi).norm(), 1e-12) << "angle " << angle;
   }
 }

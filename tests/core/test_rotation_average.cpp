@@ -1,10 +1,10 @@
 // Chordal and robust (geodesic L1, Weiszfeld) rotation means.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <random>
 #include <stdexcept>
-#include <algorithm>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@ namespace mlidar {
 namespace {
 
 using test::random_rotation_vector;
-using test::rotation_distance;
+using test::rotation_error_rad;
 
 Quat random_rotation(std::mt19937& rng) { return so3_exp(random_rotation_vector(rng, 0.0, std::numbers::pi)); }
 
@@ -26,8 +26,8 @@ TEST(ChordalMean, NoiseFreeCopiesGiveTheRotation) {
     const Quat truth = random_rotation(rng);
     std::vector<Quat> copies(7, truth);
     copies[3].coeffs() *= -1.0;  // same rotation, other sign
-    EXPECT_LT(rotation_distance(chordal_mean(copies), truth), 1e-14);
-    EXPECT_LT(rotation_distance(robust_rotation_mean(copies).mean, truth), 1e-14);
+    EXPECT_LT(rotation_error_rad(chordal_mean(copies), truth), 1e-14);
+    EXPECT_LT(rotation_error_rad(robust_rotation_mean(copies).mean, truth), 1e-14);
   }
 }
 
@@ -51,14 +51,14 @@ TEST(ChordalMean, WeightedMeanAboutOneAxis) {
       sum_cos += weights.back() * std::cos(a);
     }
     const Quat expected = so3_exp(std::atan2(sum_sin, sum_cos) * axis);
-    EXPECT_LT(rotation_distance(chordal_mean(rotations, weights), expected), 1e-12);
+    EXPECT_LT(rotation_error_rad(chordal_mean(rotations, weights), expected), 1e-12);
   }
 }
 
 TEST(ChordalMean, ZeroWeightIgnoresARotation) {
   const std::vector<Quat> rotations = {so3_exp(Vec3(0.1, 0.2, 0.3)), so3_exp(Vec3(-1.0, 2.0, 0.5))};
   const std::vector<double> weights = {2.0, 0.0};
-  EXPECT_LT(rotation_distance(chordal_mean(rotations, weights), rotations[0]), 1e-14);
+  EXPECT_LT(rotation_error_rad(chordal_mean(rotations, weights), rotations[0]), 1e-14);
 }
 
 TEST(ChordalMean, RejectsBadInput) {
@@ -89,8 +89,7 @@ OutlierCase make_outlier_case(std::mt19937& rng, bool clustered) {
   }
   const Quat wrong = c.truth * so3_exp(random_rotation_vector(rng, 0.8, 1.5));
   for (int i = 0; i < 30; ++i) {
-    c.rotations.push_back(clustered ? wrong * so3_exp(random_rotation_vector(rng, 0.0, 0.3))
-                                    : random_rotation(rng));
+    c.rotations.push_back(clustered ? wrong * so3_exp(random_rotation_vector(rng, 0.0, 0.3)) : random_rotation(rng));
   }
   std::shuffle(c.rotations.begin(), c.rotations.end(), rng);
   return c;
@@ -101,8 +100,8 @@ TEST(RobustMean, IgnoresThirtyPercentClusteredOutliers) {
   for (int trial = 0; trial < 10; ++trial) {
     const OutlierCase c = make_outlier_case(rng, /*clustered=*/true);
     const RobustMeanResult robust = robust_rotation_mean(c.rotations);
-    const double robust_error = rotation_distance(robust.mean, c.truth);
-    const double chordal_error = rotation_distance(chordal_mean(c.rotations), c.truth);
+    const double robust_error = rotation_error_rad(robust.mean, c.truth);
+    const double chordal_error = rotation_error_rad(chordal_mean(c.rotations), c.truth);
     EXPECT_TRUE(robust.converged);
     EXPECT_LT(robust_error, 1e-3);
     EXPECT_GT(chordal_error, 0.1) << "the chordal mean should be dragged by the outlier cluster";
@@ -114,8 +113,8 @@ TEST(RobustMean, IgnoresThirtyPercentUniformOutliers) {
   for (int trial = 0; trial < 10; ++trial) {
     const OutlierCase c = make_outlier_case(rng, /*clustered=*/false);
     const RobustMeanResult robust = robust_rotation_mean(c.rotations);
-    const double robust_error = rotation_distance(robust.mean, c.truth);
-    const double chordal_error = rotation_distance(chordal_mean(c.rotations), c.truth);
+    const double robust_error = rotation_error_rad(robust.mean, c.truth);
+    const double chordal_error = rotation_error_rad(chordal_mean(c.rotations), c.truth);
     EXPECT_TRUE(robust.converged);
     EXPECT_LT(robust_error, 1e-3);
     EXPECT_LT(robust_error, chordal_error);
@@ -129,7 +128,7 @@ TEST(RobustMean, IsALocalMinimumOfTheL1Cost) {
   const RobustMeanResult robust = robust_rotation_mean(c.rotations);
   auto cost = [&](const Quat& mean) {
     double sum = 0.0;
-    for (const Quat& r : c.rotations) sum += rotation_distance(mean, r);
+    for (const Quat& r : c.rotations) sum += rotation_error_rad(mean, r);
     return sum;
   };
   EXPECT_NEAR(robust.cost, cost(robust.mean), 1e-9);

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "lie_test_util.hpp"
 #include "mlidar/core/error.hpp"

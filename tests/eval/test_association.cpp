@@ -44,8 +44,7 @@ TEST(Association, JitteredStampsPairWithTheirTwins) {
   // With a tolerance smaller than the jitter only the close ones survive, still correctly paired.
   const Association tight = associate_by_time(gt, est, 0.002, "est");
   EXPECT_LT(tight.size(), kept.size());
-  for (std::size_t k = 0; k < tight.size(); ++k)
-    EXPECT_NEAR(gt.poses[tight.gt[k]].stamp, est.poses[tight.est[k]].stamp, 0.002);
+  for (std::size_t k = 0; k < tight.size(); ++k) EXPECT_NEAR(gt.poses[tight.gt[k]].stamp, est.poses[tight.est[k]].stamp, 0.002);
 }
 
 TEST(Association, PairsAreOneToOne) {
@@ -68,8 +67,7 @@ TEST(Association, EmptyAssociationIsAnInputError) {
 }
 
 TEST(Association, ByIndexNeedsEqualCounts) {
-  const std::string message =
-      input_error_of([] { associate_by_index(wavy_trajectory(10), wavy_trajectory(11), "est.kitti"); });
+  const std::string message = input_error_of([] { associate_by_index(wavy_trajectory(10), wavy_trajectory(11), "est.kitti"); });
   EXPECT_NE(message.find("est.kitti"), std::string::npos) << message;
   EXPECT_EQ(associate_by_index(wavy_trajectory(10), wavy_trajectory(10), "e").size(), 10U);
 }
@@ -82,8 +80,7 @@ TEST(Validation, BadTrajectoriesNameTheFileAndPose) {
   EXPECT_NE(message.find("pose 4"), std::string::npos) << message;
 
   Trajectory nan_rotation = wavy_trajectory(10);
-  nan_rotation.poses[2].T_world_base =
-      SE3(Quat(std::numeric_limits<double>::quiet_NaN(), 0, 0, 0), Vec3::Zero());
+  nan_rotation.poses[2].T_world_base = SE3(Quat(std::numeric_limits<double>::quiet_NaN(), 0, 0, 0), Vec3::Zero());
   message = input_error_of([&] { validate_trajectory(nan_rotation, "a.tum"); });
   EXPECT_NE(message.find("pose 2"), std::string::npos) << message;
 
@@ -103,9 +100,8 @@ TEST(Validation, BadTrajectoriesNameTheFileAndPose) {
 TEST(Validation, EvaluateRejectsBadEstimate) {
   Trajectory est = wavy_trajectory(30);
   est.poses[3].stamp = 0.0;
-  const std::string message = input_error_of([&] {
-    evaluate_trajectory(wavy_trajectory(30), est, TrajectoryEvalOptions{}, "gt.tum", "est.tum");
-  });
+  const std::string message =
+      input_error_of([&] { evaluate_trajectory(wavy_trajectory(30), est, TrajectoryEvalOptions{}, "gt.tum", "est.tum"); });
   EXPECT_NE(message.find("est.tum"), std::string::npos) << message;
 }
 

@@ -30,8 +30,8 @@ std::string tum_text(int count, double offset_x = 0.0) {
   for (int i = 0; i < count; ++i) {
     const double s = 0.1 * i;
     const double yaw = 0.3 * s;
-    std::snprintf(line, sizeof(line), "%.6f %.17g %.17g %.17g 0 0 %.17g %.17g\n", 10.0 + 0.1 * i,
-                  5.0 * std::cos(s) + offset_x, 3.0 * std::sin(s), 0.1 * s, std::sin(yaw / 2), std::cos(yaw / 2));
+    std::snprintf(line, sizeof(line), "%.6f %.17g %.17g %.17g 0 0 %.17g %.17g\n", 10.0 + 0.1 * i, 5.0 * std::cos(s) + offset_x,
+                  3.0 * std::sin(s), 0.1 * s, std::sin(yaw / 2), std::cos(yaw / 2));
     text += line;
   }
   return text;
@@ -47,8 +47,8 @@ TEST(CliEval, TrajectoryOffsetGivesKnownAteAndAlignsAway) {
   EXPECT_NE(result.output.find("ATE"), std::string::npos);
   EXPECT_NEAR(read_json(dir / "none.json")["ate"]["translation_m"]["rmse"].get<double>(), 0.25, 1e-9);
 
-  result = run_cli("eval traj" + files + " --json " + quoted((dir / "se3.json").string()) + " --plot " +
-                   quoted((dir / "plot.svg").string()));
+  result =
+      run_cli("eval traj" + files + " --json " + quoted((dir / "se3.json").string()) + " --plot " + quoted((dir / "plot.svg").string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const auto json = read_json(dir / "se3.json");
   EXPECT_LT(json["ate"]["translation_m"]["rmse"].get<double>(), 1e-9);
@@ -78,8 +78,7 @@ TEST(CliEval, BadTrajectoriesExitThree) {
   };
   for (const auto& bad : cases) {
     write_text(dir / bad.name, bad.text);
-    const CliResult result =
-        run_cli("eval traj --gt " + quoted((dir / "gt.tum").string()) + " --est " + quoted((dir / bad.name).string()));
+    const CliResult result = run_cli("eval traj --gt " + quoted((dir / "gt.tum").string()) + " --est " + quoted((dir / bad.name).string()));
     EXPECT_EQ(result.exit_code, 3) << bad.name << ": " << result.output;
     EXPECT_NE(result.output.find(bad.name), std::string::npos) << bad.name << ": " << result.output;
   }
@@ -123,8 +122,8 @@ TEST(CliEval, MapEntropyOfGaussianCloud) {
   cloud.format = io::CloudFormat::kPly;
   cloud.table = io::from_scan(scan);
   io::write_cloud(dir / "map.ply", cloud);
-  const CliResult result = run_cli("eval map --map " + quoted((dir / "map.ply").string()) + " --radius 50 --json " +
-                                   quoted((dir / "m.json").string()));
+  const CliResult result =
+      run_cli("eval map --map " + quoted((dir / "map.ply").string()) + " --radius 50 --json " + quoted((dir / "m.json").string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const auto json = read_json(dir / "m.json");
   EXPECT_EQ(json["points_used"].get<int>(), 2000);

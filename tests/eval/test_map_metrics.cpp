@@ -4,8 +4,8 @@
 #include <numbers>
 #include <random>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "mlidar/eval/map_metrics.hpp"
 

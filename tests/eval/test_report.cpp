@@ -49,8 +49,7 @@ TEST(Report, CalibrationJson) {
 TEST(SvgPlot, ThreeLinesWithOneVertexPerPose) {
   const Trajectory gt = test::wavy_trajectory(120);
   const TrajectoryReport report = evaluate_trajectory(gt, gt, TrajectoryEvalOptions{}, "gt", "est");
-  const std::string svg =
-      trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
+  const std::string svg = trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
   EXPECT_EQ(svg.rfind("<svg", 0), 0U);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
   const std::regex polyline("<polyline[^>]*points=\"([^\"]*)\"");

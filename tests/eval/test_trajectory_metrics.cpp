@@ -21,8 +21,8 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 Trajectory transformed(const Trajectory& trajectory, const SE3& T, double scale = 1.0) {
   Trajectory out = trajectory;
   for (StampedPose& pose : out.poses) {
-    pose.T_world_base = SE3(T.rotation() * pose.T_world_base.rotation(),
-                            scale * (T.rotation() * pose.T_world_base.translation()) + T.translation());
+    pose.T_world_base =
+        SE3(T.rotation() * pose.T_world_base.rotation(), scale * (T.rotation() * pose.T_world_base.translation()) + T.translation());
   }
   return out;
 }
@@ -54,7 +54,8 @@ TEST(Ate, WithoutAlignmentGivesTheOffsetError) {
   const Trajectory est = transformed(gt, kOffset);
   const TrajectoryReport report = evaluate(gt, est, AlignMode::kNone);
   double sum_sq = 0.0;
-  for (const StampedPose& pose : gt.poses) sum_sq += (kOffset * pose.T_world_base.translation() - pose.T_world_base.translation()).squaredNorm();
+  for (const StampedPose& pose : gt.poses)
+    sum_sq += (kOffset * pose.T_world_base.translation() - pose.T_world_base.translation()).squaredNorm();
   EXPECT_NEAR(report.ate.translation_m.rmse, std::sqrt(sum_sq / 300.0), 1e-9);
   // R_gt^T (R R_gt) is conjugate to R: the same angle for every pose.
   const double angle_deg = so3_log(kOffset.rotation()).norm() / kDeg;

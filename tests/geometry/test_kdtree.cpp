@@ -23,8 +23,7 @@ std::vector<Eigen::Vector3f> random_cloud(std::size_t count, unsigned seed) {
 
 std::vector<Neighbor> brute_force_all(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& query) {
   std::vector<Neighbor> all(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i)
-    all[i] = {static_cast<std::uint32_t>(i), (points[i] - query).squaredNorm()};
+  for (std::size_t i = 0; i < points.size(); ++i) all[i] = {static_cast<std::uint32_t>(i), (points[i] - query).squaredNorm()};
   std::sort(all.begin(), all.end(), [](const Neighbor& a, const Neighbor& b) {
     return a.distance_sq < b.distance_sq || (a.distance_sq == b.distance_sq && a.index < b.index);
   });

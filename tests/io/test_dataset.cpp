@@ -12,7 +12,8 @@ Dataset example() {
   Dataset dataset;
   dataset.name = "rv-campus";
   dataset.frame_period = 0.1;
-  dataset.base = "top";
+  dataset.base = "vehicle";  // a frame that is no LiDAR, placed by top's extrinsic
+  dataset.reference_lidar = "top";
   DatasetLidar top;
   top.name = "top";
   top.model.name = "RS-LiDAR-16";
@@ -37,7 +38,8 @@ TEST(Dataset, YamlRoundTripIsExact) {
   const Dataset read = read_dataset_yaml(dir);
   EXPECT_EQ(read.name, original.name);
   EXPECT_EQ(read.frame_period, original.frame_period);
-  EXPECT_EQ(read.base, "top");
+  EXPECT_EQ(read.base, "vehicle");
+  EXPECT_EQ(read.reference_lidar, "top");
   ASSERT_EQ(read.lidars.size(), 2u);
   EXPECT_EQ(read.lidars[0].model.vertical_angles_deg, original.lidars[0].model.vertical_angles_deg);
   EXPECT_EQ(read.lidars[0].scans, "scans/top");
@@ -59,8 +61,22 @@ TEST(Dataset, ErrorsNameTheKey) {
       EXPECT_EQ(e.field(), key) << e.what();
     }
   };
-  const std::string head = "name: x\nframe_period: 0.1\n";
+  const std::string head = "name: x\nframe_period: 0.1\nbase: a\n";
   expect_key("name: x\n", "frame_period");
+  expect_key("name: x\nframe_period: 0.1\nlidars: [{name: a, model: m, scans: s}]\n", "base");             // missing
+  expect_key("name: x\nframe_period: 0.1\nbase: top\nlidars: [{name: a, model: m, scans: s}]\n", "base");  // no such LiDAR
+  expect_key("name: x\nframe_period: 0.1\nbase: v\nreference_lidar: a\nlidars: [{name: a, model: m, scans: s}]\n",
+             "reference_lidar");  // it places the frame: its extrinsic is needed
+  expect_key(head + "reference_lidar: b\nlidars: [{name: a, model: m, scans: s}, {name: b, model: m, scans: t}]\n",
+             "reference_lidar");  // the base is a LiDAR: it places the frame
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, initial_extrinsic: {translation: [1, 0, 0], quaternion_wxyz: [1, 0, 0, 0]}}]\n",
+             "base");  // the base LiDAR's extrinsic must be the identity
+  expect_key(head + "frame_period: 0.2\nlidars: [{name: a, model: m, scans: s}]\n", "frame_period");       // given twice
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, min_range: 1, min_range: 2}]\n", "lidars[0].min_range");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, vertical_angles_deg: [-1, 1, 0]}]\n", "lidars[0].vertical_angles_deg[2]");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, vertical_angles_deg: [-1, 1, 1]}]\n", "lidars[0].vertical_angles_deg[2]");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, min_range: 5, max_range: 5}]\n", "lidars[0].max_range");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, time_unit: weeks}]\n", "lidars[0].time_unit");
   expect_key(head, "lidars");
   expect_key(head + "lidars: [{name: a, model: m, scans: s}]\ncolour: red\n", "colour");
   expect_key(head + "lidars: [{name: a, model: m}]\n", "lidars[0].scans");
@@ -68,8 +84,9 @@ TEST(Dataset, ErrorsNameTheKey) {
   expect_key(head + "lidars: [{name: a, model: m, scans: s}, {name: a, model: m, scans: t}]\n", "lidars[1].name");
   expect_key(head + "lidars: [{name: a, model: m, scans: s, initial_extrinsic: {translation: [1, 2, 3], quaternion_wxyz: [2, 0, 0, 0]}}]\n",
              "lidars[0].initial_extrinsic.quaternion_wxyz");
-  expect_key("name: x\nframe_period: -1\nlidars: [{name: a, model: m, scans: s}]\n", "frame_period");
+  expect_key("name: x\nframe_period: -1\nbase: a\nlidars: [{name: a, model: m, scans: s}]\n", "frame_period");
   expect_key("{", "(document)");
+  expect_key("? [a, b]\n: 1\n", "(document)");  // a key that is not a plain name (found by fuzz_dataset)
 }
 
 TEST(Dataset, TimesRoundTripAndValidation) {

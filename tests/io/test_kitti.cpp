@@ -175,7 +175,8 @@ TEST(KittiRejects, CalibMissingKeysWrongCountsAndDuplicates) {
   expect_input_error([&] { parse_kitti_calib(no_r0, "c.txt"); }, {"c.txt", "R0_rect", "missing"});
   expect_input_error([] { parse_kitti_calib(valid_calib() + "Tr_imu_to_velo: 1 2 3\n", "c.txt"); },
                      {"c.txt", "line 7 (Tr_imu_to_velo)", "expected 12 numbers, found 3"});
-  expect_input_error([] { parse_kitti_calib(valid_calib() + "P2: 1 0 0 0 0 1 0 0 0 0 1 0\n", "c.txt"); }, {"c.txt", "line 7 (P2)", "twice"});
+  expect_input_error([] { parse_kitti_calib(valid_calib() + "P2: 1 0 0 0 0 1 0 0 0 0 1 0\n", "c.txt"); },
+                     {"c.txt", "line 7 (P2)", "twice"});
   expect_input_error([] { parse_kitti_calib(valid_calib() + "garbage\n", "c.txt"); }, {"c.txt", "line 7", "NAME: numbers"});
   expect_input_error([] { parse_kitti_calib("P0: 1 2 abc\n", "c.txt"); }, {"c.txt", "line 1 (P0)", "'abc'"});
 }

@@ -47,9 +47,7 @@ std::size_t compressed_prefix_offset(const std::vector<std::byte>& file) {
   return text.find(marker) + marker.size();
 }
 
-void set_u32(std::vector<std::byte>& bytes, std::size_t offset, std::uint32_t value) {
-  std::memcpy(bytes.data() + offset, &value, 4);
-}
+void set_u32(std::vector<std::byte>& bytes, std::size_t offset, std::uint32_t value) { std::memcpy(bytes.data() + offset, &value, 4); }
 
 TEST(PcdReject, CraftedFilesParseWhenIntact) {
   EXPECT_EQ(parse_pcd(to_bytes(kAscii), "ok").table.num_points, 2u);
@@ -91,8 +89,8 @@ TEST(PcdReject, PerFieldLinesMustMatchFields) {
 }
 
 TEST(PcdReject, InvalidTypeSizePairs) {
-  for (const char* pair : {"SIZE 4 4 2\nTYPE F F F", "SIZE 4 4 1\nTYPE F F F", "SIZE 4 4 3\nTYPE F F I",
-                           "SIZE 4 4 16\nTYPE F F U", "SIZE 4 4 4\nTYPE F F X", "SIZE 4 4 4\nTYPE F F FF"}) {
+  for (const char* pair : {"SIZE 4 4 2\nTYPE F F F", "SIZE 4 4 1\nTYPE F F F", "SIZE 4 4 3\nTYPE F F I", "SIZE 4 4 16\nTYPE F F U",
+                           "SIZE 4 4 4\nTYPE F F X", "SIZE 4 4 4\nTYPE F F FF"}) {
     expect_rejected(edited("SIZE 4 4 4\nTYPE F F F", pair), "TYPE");
   }
   expect_rejected(edited("SIZE 4 4 4", "SIZE 4 4 four"), "SIZE");
@@ -115,17 +113,17 @@ TEST(PcdReject, BinaryDataShorterThanPromised) {
 }
 
 TEST(PcdReject, AsciiRowsAndValues) {
-  expect_rejected(edited("4 5 6\n", ""), "DATA");                       // fewer rows than POINTS
-  expect_rejected(edited("4 5 6\n", "4 5\n"), "DATA");                  // short row
-  expect_rejected(edited("4 5 6\n", "4 5 6 7\n"), "DATA");              // long row
-  expect_rejected(edited("4 5 6\n", "4 five 6\n"), "DATA");             // not a number
-  expect_rejected(edited("4 5 6\n", "4 5 1e39\n"), "DATA");             // beyond float32
+  expect_rejected(edited("4 5 6\n", ""), "DATA");                                 // fewer rows than POINTS
+  expect_rejected(edited("4 5 6\n", "4 5\n"), "DATA");                            // short row
+  expect_rejected(edited("4 5 6\n", "4 5 6 7\n"), "DATA");                        // long row
+  expect_rejected(edited("4 5 6\n", "4 five 6\n"), "DATA");                       // not a number
+  expect_rejected(edited("4 5 6\n", "4 5 1e39\n"), "DATA");                       // beyond float32
   EXPECT_EQ(parse_pcd(to_bytes(kAscii + "7 8 9\n"), "ok").table.num_points, 2u);  // extra rows ignored
   EXPECT_TRUE(std::isnan(parse_pcd(to_bytes(edited("4 5 6", "nan -inf +6")), "ok").table.fields[0].value(1)));
   const std::string ints = edited("SIZE 4 4 4\nTYPE F F F", "SIZE 4 4 1\nTYPE F F U");
-  expect_rejected(edited("4 5 6", "4 5 256", ints), "DATA");            // beyond uint8
-  expect_rejected(edited("4 5 6", "4 5 -1", ints), "DATA");             // negative unsigned
-  expect_rejected(edited("4 5 6", "4 5 1.5", ints), "DATA");            // not an integer
+  expect_rejected(edited("4 5 6", "4 5 256", ints), "DATA");  // beyond uint8
+  expect_rejected(edited("4 5 6", "4 5 -1", ints), "DATA");   // negative unsigned
+  expect_rejected(edited("4 5 6", "4 5 1.5", ints), "DATA");  // not an integer
   EXPECT_EQ(parse_pcd(to_bytes(edited("4 5 6", "4 5 255", ints)), "ok").table.fields[2].value(1), 255.0);
 }
 

@@ -31,7 +31,7 @@ template <typename T>
 void fill_floats(FieldColumn& column, std::mt19937_64& rng) {
   using Limits = std::numeric_limits<T>;
   const T specials[] = {Limits::quiet_NaN(), Limits::infinity(), -Limits::infinity(), T(-0.0), Limits::denorm_min(),
-                        Limits::min(), Limits::max(), Limits::lowest(), T(0.1), T(1) / T(3)};
+                        Limits::min(),       Limits::max(),      Limits::lowest(),    T(0.1),  T(1) / T(3)};
   std::uniform_real_distribution<T> uniform(T(-200), T(200));
   std::size_t index = 0;
   for (std::size_t offset = 0; offset < column.data.size(); offset += sizeof(T), ++index) {
@@ -42,16 +42,26 @@ void fill_floats(FieldColumn& column, std::mt19937_64& rng) {
 
 void fill(FieldColumn& column, std::mt19937_64& rng) {
   switch (column.type) {
-    case ScalarType::kI8: return fill_random_integers<std::int8_t>(column, rng);
-    case ScalarType::kU8: return fill_random_integers<std::uint8_t>(column, rng);
-    case ScalarType::kI16: return fill_random_integers<std::int16_t>(column, rng);
-    case ScalarType::kU16: return fill_random_integers<std::uint16_t>(column, rng);
-    case ScalarType::kI32: return fill_random_integers<std::int32_t>(column, rng);
-    case ScalarType::kU32: return fill_random_integers<std::uint32_t>(column, rng);
-    case ScalarType::kI64: return fill_random_integers<std::int64_t>(column, rng);
-    case ScalarType::kU64: return fill_random_integers<std::uint64_t>(column, rng);
-    case ScalarType::kF32: return fill_floats<float>(column, rng);
-    case ScalarType::kF64: return fill_floats<double>(column, rng);
+    case ScalarType::kI8:
+      return fill_random_integers<std::int8_t>(column, rng);
+    case ScalarType::kU8:
+      return fill_random_integers<std::uint8_t>(column, rng);
+    case ScalarType::kI16:
+      return fill_random_integers<std::int16_t>(column, rng);
+    case ScalarType::kU16:
+      return fill_random_integers<std::uint16_t>(column, rng);
+    case ScalarType::kI32:
+      return fill_random_integers<std::int32_t>(column, rng);
+    case ScalarType::kU32:
+      return fill_random_integers<std::uint32_t>(column, rng);
+    case ScalarType::kI64:
+      return fill_random_integers<std::int64_t>(column, rng);
+    case ScalarType::kU64:
+      return fill_random_integers<std::uint64_t>(column, rng);
+    case ScalarType::kF32:
+      return fill_floats<float>(column, rng);
+    case ScalarType::kF64:
+      return fill_floats<double>(column, rng);
   }
 }
 
@@ -127,8 +137,8 @@ TEST(PcdRoundTrip, CompressedBlockWithPaddingColumnsKeepsThem) {
   std::vector<std::byte> block;
   for (const FieldColumn& column : cloud.table.fields) block.insert(block.end(), column.data.begin(), column.data.end());
   std::vector<std::byte> compressed(block.size() * 2 + 64);
-  const unsigned int compressed_size = lzf_compress(block.data(), static_cast<unsigned int>(block.size()), compressed.data(),
-                                                    static_cast<unsigned int>(compressed.size()));
+  const unsigned int compressed_size =
+      lzf_compress(block.data(), static_cast<unsigned int>(block.size()), compressed.data(), static_cast<unsigned int>(compressed.size()));
   ASSERT_GT(compressed_size, 0u);
   const std::vector<std::byte> pcl_style = encode_pcd(cloud);
   const std::string marker = "DATA binary_compressed\n";
@@ -177,8 +187,7 @@ TEST(PcdRoundTrip, DropNanRemovesNonFinitePointsAndFlattens) {
   const PointTable& table = cloud.table;
   std::vector<std::size_t> finite;
   for (std::size_t i = 0; i < table.num_points; ++i) {
-    if (std::isfinite(table.find("x")->value(i)) && std::isfinite(table.find("y")->value(i)) &&
-        std::isfinite(table.find("z")->value(i))) {
+    if (std::isfinite(table.find("x")->value(i)) && std::isfinite(table.find("y")->value(i)) && std::isfinite(table.find("z")->value(i))) {
       finite.push_back(i);
     }
   }

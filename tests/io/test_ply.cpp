@@ -55,14 +55,22 @@ std::string ascii_value(const FieldColumn& column, std::size_t i) {
     return std::string(text.data(), end);
   };
   switch (column.type) {
-    case ScalarType::kI8: return print(std::int8_t{});
-    case ScalarType::kU8: return print(std::uint8_t{});
-    case ScalarType::kI16: return print(std::int16_t{});
-    case ScalarType::kU16: return print(std::uint16_t{});
-    case ScalarType::kI32: return print(std::int32_t{});
-    case ScalarType::kU32: return print(std::uint32_t{});
-    case ScalarType::kF32: return print(float{});
-    default: return print(double{});
+    case ScalarType::kI8:
+      return print(std::int8_t{});
+    case ScalarType::kU8:
+      return print(std::uint8_t{});
+    case ScalarType::kI16:
+      return print(std::int16_t{});
+    case ScalarType::kU16:
+      return print(std::uint16_t{});
+    case ScalarType::kI32:
+      return print(std::int32_t{});
+    case ScalarType::kU32:
+      return print(std::uint32_t{});
+    case ScalarType::kF32:
+      return print(float{});
+    default:
+      return print(double{});
   }
 }
 
@@ -195,7 +203,9 @@ TEST(PlyRealData, ScanPairMatchesItsPcdTwinsPointForPoint) {
   }
 }
 
-TEST(PlyRejects, MissingMagic) { expect_input_error([] { parse_ply(bytes_of("plyx\nformat ascii 1.0\n"), "m.ply"); }, {"m.ply", "'ply' magic"}); }
+TEST(PlyRejects, MissingMagic) {
+  expect_input_error([] { parse_ply(bytes_of("plyx\nformat ascii 1.0\n"), "m.ply"); }, {"m.ply", "'ply' magic"});
+}
 
 TEST(PlyRejects, UnknownFormat) {
   expect_input_error([] { parse_ply(bytes_of("ply\nformat binary_middle_endian 1.0\nend_header\n"), "f.ply"); },
@@ -228,21 +238,26 @@ TEST(PlyRejects, AsciiDataShorterThanPromised) {
 }
 
 TEST(PlyRejects, AbsurdCountWithoutOverflow) {
-  const std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\nproperty double x\n"
-                           "property double y\nend_header\n" + std::string(64, '\0');
+  const std::string text =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\nproperty double x\n"
+      "property double y\nend_header\n" +
+      std::string(64, '\0');
   expect_input_error([&] { parse_ply(bytes_of(text), "c.ply"); }, {"c.ply", "element vertex", "promises 18446744073709551615 rows"});
   expect_input_error([&] { parse_ply(bytes_of("ply\nformat ascii 1.0\nelement vertex 99999999999999999999\nend_header\n"), "c.ply"); },
                      {"c.ply", "header line 3", "element count"});
 }
 
 TEST(PlyRejects, ListCountRunningPastTheData) {
-  std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
-                       "element face 1\nproperty list uint int idx\nend_header\n" + std::string(4, '\0');
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+      "element face 1\nproperty list uint int idx\nend_header\n" +
+      std::string(4, '\0');
   put<std::uint32_t>(binary, 1000000000u, false);
   binary += std::string(8, '\0');
   expect_input_error([&] { parse_ply(bytes_of(binary), "l.ply"); }, {"l.ply", "element face row 0 property idx", "runs past"});
-  const std::string ascii = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement face 1\n"
-                            "property list uchar int idx\nend_header\n1\n200 1 2 3\n";
+  const std::string ascii =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement face 1\n"
+      "property list uchar int idx\nend_header\n1\n200 1 2 3\n";
   expect_input_error([&] { parse_ply(bytes_of(ascii), "l.ply"); }, {"l.ply", "element face row 0 property idx", "runs past"});
 }
 

@@ -6,6 +6,7 @@
 
 #include "format_test_util.hpp"
 #include "mlidar/io/trajectory_io.hpp"
+#include "pose_error.hpp"
 #include "test_support.hpp"
 
 namespace mlidar::io {
@@ -26,7 +27,7 @@ Trajectory random_trajectory(unsigned seed, std::size_t n) {
   return trajectory;
 }
 
-double rotation_angle_between(const SE3& a, const SE3& b) { return a.rotation().angularDistance(b.rotation()); }
+using mlidar::test::rotation_error_rad;
 
 void expect_close(const Trajectory& expected, const Trajectory& actual, double tolerance, bool same_stamps) {
   ASSERT_EQ(actual.size(), expected.size());
@@ -35,7 +36,7 @@ void expect_close(const Trajectory& expected, const Trajectory& actual, double t
       EXPECT_EQ(actual.poses[i].stamp, expected.poses[i].stamp);
     }
     EXPECT_LT((actual.poses[i].T_world_base.translation() - expected.poses[i].T_world_base.translation()).norm(), tolerance);
-    EXPECT_LT(rotation_angle_between(actual.poses[i].T_world_base, expected.poses[i].T_world_base), tolerance);
+    EXPECT_LT(rotation_error_rad(actual.poses[i].T_world_base, expected.poses[i].T_world_base), tolerance);
   }
 }
 
@@ -74,8 +75,11 @@ TEST(KittiPosesRejects, EachRuleNamesFileAndLine) {
                      {"p.txt", "line 2", "not a rotation"});
   expect_input_error([] { parse_kitti_poses("-1 0 0 0 0 1 0 0 0 0 1 0\n", "p.txt"); }, {"p.txt", "line 1", "det"});
   expect_input_error([] { parse_kitti_poses("1 0 0 0 0 1 0 0 0 0 1 0\n", "p.txt", {1.0, 2.0}); }, {"p.txt", "1 poses but 2 stamps"});
-  expect_input_error([] { parse_kitti_poses("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 0\n", "p.txt", {2.0, 1.0}); },
-                     {"p.txt", "line 2", "not after"});
+  expect_input_error(
+      [] {
+        parse_kitti_poses("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 0\n", "p.txt", {2.0, 1.0});
+      },
+      {"p.txt", "line 2", "not after"});
 }
 
 TEST(KittiPosesReader, ReorthonormalisesPrintedRotations) {
@@ -91,7 +95,7 @@ TEST(PoseFilesRealData, ScanPairReferencesAgree) {
   const auto folder = test::shared_data() / "real/scan_pair";
   const SE3 a = read_matrix_transform(folder / "T_target_source.txt");
   const SE3 b = read_matrix_transform(folder / "relative.txt");
-  EXPECT_LT(rotation_angle_between(a, b), 0.5 * M_PI / 180.0);
+  EXPECT_LT(rotation_error_rad(a, b), 0.5 * M_PI / 180.0);
   EXPECT_LT((a.translation() - b.translation()).norm(), 0.05);
   EXPECT_NEAR(a.translation().x(), 0.488882, 1e-9);  // as printed in the file
 }

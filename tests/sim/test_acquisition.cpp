@@ -37,7 +37,8 @@ double surface_distance(const Primitive& s, const Vec3& p) {
       const double cap = radial <= s.radius + 1e-6 ? std::abs(std::abs(local.z()) - s.half_extent.z()) : inf;
       return std::min(side, cap);
     }
-    case PrimitiveKind::kSphere: return std::abs((p - s.centre).norm() - s.radius);
+    case PrimitiveKind::kSphere:
+      return std::abs((p - s.centre).norm() - s.radius);
     case PrimitiveKind::kGround: {
       const Vec3 normal = Vec3(-s.slope.x(), -s.slope.y(), 1.0).normalized();
       return std::abs(normal.dot(p - s.centre));

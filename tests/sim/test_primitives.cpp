@@ -96,9 +96,12 @@ Primitive random_primitive(std::mt19937_64& rng, int index) {
   std::uniform_real_distribution<double> size(0.2, 3.0);
   const Vec3 centre(pos(rng), pos(rng), size(rng));
   switch (index % 4) {
-    case 0: return make_box(centre, pos(rng), Vec3(size(rng), size(rng), size(rng)), 0.5);
-    case 1: return make_cylinder(centre, size(rng) * 0.3, size(rng), 0.5);
-    case 2: return make_sphere(centre, size(rng) * 0.5, 0.5);
+    case 0:
+      return make_box(centre, pos(rng), Vec3(size(rng), size(rng), size(rng)), 0.5);
+    case 1:
+      return make_cylinder(centre, size(rng) * 0.3, size(rng), 0.5);
+    case 2:
+      return make_sphere(centre, size(rng) * 0.5, 0.5);
     default: {
       const Mat3 axes = Eigen::AngleAxisd(pos(rng), Vec3(0.3, 0.4, 1.0).normalized()).toRotationMatrix();
       return make_rectangle(centre, axes, size(rng), size(rng), 0.5);

@@ -44,7 +44,8 @@ lidars:
     rotation_rpy_deg: [0, 0, 90]
     dropout: 0.1
     sweep_offset: 0.05
-)", "rig.yaml");
+)",
+                                    "rig.yaml");
   EXPECT_EQ(rig.base_frame, "a");
   ASSERT_EQ(rig.lidars.size(), 2u);
   EXPECT_EQ(rig.lidars[1].model.vertical_angles_deg, (std::vector<double>{-5, 0, 5}));
@@ -115,8 +116,9 @@ TEST(Trajectories, SplineFollowsPosesAndIsC2) {
   // C2: the second difference of position is continuous across a knot (t = 2.0).
   auto accel = [&](double t) {
     const double h = 1e-4;
-    return Vec3((spline.T_world_base(t + h).translation() - 2 * spline.T_world_base(t).translation() +
-                 spline.T_world_base(t - h).translation()) / (h * h));
+    return Vec3(
+        (spline.T_world_base(t + h).translation() - 2 * spline.T_world_base(t).translation() + spline.T_world_base(t - h).translation()) /
+        (h * h));
   };
   // A jump in acceleration would be O(1 m/s^2); the jerk over 4e-4 s is ~0.02.
   EXPECT_LT((accel(2.0 - 2e-4) - accel(2.0 + 2e-4)).norm(), 0.05);

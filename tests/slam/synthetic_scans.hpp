@@ -60,10 +60,16 @@ inline CastScan cast_scan(const LidarModel& model, double ground_z, const std::v
       const Eigen::Vector3d d(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
       double best = std::numeric_limits<double>::infinity();
       int id = -2;
-      if (d.z() < -1e-9) { best = ground_z / d.z(); id = 0; }
+      if (d.z() < -1e-9) {
+        best = ground_z / d.z();
+        id = 0;
+      }
       for (const auto& box : boxes) {
         const double t = hit_box(box, d);
-        if (t < best) { best = t; id = box.id; }
+        if (t < best) {
+          best = t;
+          id = box.id;
+        }
       }
       if (room != nullptr) {
         double exit = std::numeric_limits<double>::infinity();
@@ -71,7 +77,10 @@ inline CastScan cast_scan(const LidarModel& model, double ground_z, const std::v
           if (std::abs(d[a]) < 1e-12) continue;
           exit = std::min(exit, (d[a] > 0 ? room->max[a] : room->min[a]) / d[a]);
         }
-        if (exit < best) { best = exit; id = -1; }
+        if (exit < best) {
+          best = exit;
+          id = -1;
+        }
       }
       if (!std::isfinite(best) || best > model.max_range) continue;
       out.scan.points.push_back((best * d).cast<float>());

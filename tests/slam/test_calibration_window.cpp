@@ -4,8 +4,8 @@
 // no features nothing is solved and the start is returned.
 #include <array>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "mlidar/slam/calibration_window.hpp"
 
@@ -35,7 +35,8 @@ TEST(CalibrationWindow, RecoversTheExtrinsicWithoutNoise) {
   Vec6 truth_tangent;
   truth_tangent << 0.1, -0.4, -0.2, 0.7, 0.05, -0.1;
   const SE3 T_true = SE3::exp(truth_tangent);
-  const std::array<Vec6, 3> pose_tangents = {(Vec6() << 1.0, 1.0, 1.5, 0, 0, 0).finished(), (Vec6() << 1.5, 1.2, 1.4, 0.05, 0, 0.3).finished(),
+  const std::array<Vec6, 3> pose_tangents = {(Vec6() << 1.0, 1.0, 1.5, 0, 0, 0).finished(),
+                                             (Vec6() << 1.5, 1.2, 1.4, 0.05, 0, 0.3).finished(),
                                              (Vec6() << 2.0, 1.5, 1.6, 0, -0.05, 0.6).finished()};
   std::vector<CalibrationFrame> frames;
   for (const Vec6& tangent : pose_tangents) {

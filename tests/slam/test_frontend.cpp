@@ -36,7 +36,8 @@ TEST(RangeImage, RowsFromElevationMatchRings) {
   build_range_image(cast.scan.points, cast.scan.ring, model, with_ring);
   build_range_image(cast.scan.points, {}, model, from_elevation);
   EXPECT_EQ(with_ring.index, from_elevation.index);
-  const std::size_t filled = static_cast<std::size_t>(std::count_if(with_ring.index.begin(), with_ring.index.end(), [](int i) { return i >= 0; }));
+  const std::size_t filled =
+      static_cast<std::size_t>(std::count_if(with_ring.index.begin(), with_ring.index.end(), [](int i) { return i >= 0; }));
   EXPECT_EQ(filled, cast.scan.size());  // one point per pixel: none lost, none merged
   for (std::size_t p = 0; p < with_ring.index.size(); ++p)
     if (with_ring.index[p] >= 0) {
@@ -52,9 +53,9 @@ struct SegmentedScene {
 
 SegmentedScene segment_boxes(double threshold_deg) {
   const LidarModel model = test::uniform_model(32, -25.0, 10.0, 0.4);
-  const std::vector<AxisBox> boxes = {{{5, -1, -1.5}, {6, 1, 1.0}, 1},     // box ahead
-                                      {{-2, 6, -1.5}, {2, 7, 0.5}, 2},     // box to the left
-                                      {{-8, -6, -1.5}, {-6, -4, 2.0}, 3},  // box behind right, seen obliquely
+  const std::vector<AxisBox> boxes = {{{5, -1, -1.5}, {6, 1, 1.0}, 1},             // box ahead
+                                      {{-2, 6, -1.5}, {2, 7, 0.5}, 2},             // box to the left
+                                      {{-8, -6, -1.5}, {-6, -4, 2.0}, 3},          // box behind right, seen obliquely
                                       {{2.0, -9.3, -1.5}, {2.3, -9.0, -1.2}, 4}};  // a rock: few points
   SegmentedScene out;
   out.cast = test::cast_scan(model, -1.5, boxes);
@@ -170,11 +171,14 @@ FeatureIndices select_by_full_sort(std::span<const float> curvature, std::span<c
   FeatureIndices out;
   const int n = static_cast<int>(curvature.size());
   std::vector<std::uint8_t> blocked(curvature.size(), 0);
-  const auto block = [&](int i) { for (int k = std::max(0, i - 5); k <= std::min(n - 1, i + 5); ++k) blocked[static_cast<std::size_t>(k)] = 1; };
+  const auto block = [&](int i) {
+    for (int k = std::max(0, i - 5); k <= std::min(n - 1, i + 5); ++k) blocked[static_cast<std::size_t>(k)] = 1;
+  };
   for (int s = 0; s < config.sectors; ++s) {
     std::vector<int> order;
     for (int i = 5 + (n - 10) * s / config.sectors; i < 5 + (n - 10) * (s + 1) / config.sectors; ++i) order.push_back(i);
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return curvature[static_cast<std::size_t>(a)] > curvature[static_cast<std::size_t>(b)]; });
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return curvature[static_cast<std::size_t>(a)] > curvature[static_cast<std::size_t>(b)]; });
     int edges = 0, planes = 0;
     for (const int i : order)
       if (edges < config.edges_per_sector && blocked[static_cast<std::size_t>(i)] == 0 && ground[static_cast<std::size_t>(i)] == 0) {
@@ -237,7 +241,8 @@ TEST(RangeImage, FastAtan2MatchesStdAtan2) {
   }
   EXPECT_LT(worst, 5e-8);
   for (const double y : {0.0, -0.0, 1.0, -1.0})
-    for (const double x : {0.0, -0.0, 1.0, -1.0}) EXPECT_NEAR(fast_atan2(y, x), x == 0.0 && y == 0.0 ? 0.0 : std::atan2(y, x), 5e-8) << y << " " << x;
+    for (const double x : {0.0, -0.0, 1.0, -1.0})
+      EXPECT_NEAR(fast_atan2(y, x), x == 0.0 && y == 0.0 ? 0.0 : std::atan2(y, x), 5e-8) << y << " " << x;
 }
 
 TEST(Deskew, TrueMotionRestoresTheCloud) {

@@ -48,8 +48,10 @@ SmallWindow small_window(std::uint64_t seed) {
 void dense_jacobian(const WindowProblem& problem, const WindowState& state, const VariableLayout& layout, Eigen::MatrixXd& J,
                     Eigen::VectorXd& r) {
   std::vector<std::tuple<ResidualRows, int, int>> all;
-  for (const auto& c : problem.planes) all.emplace_back(plane_rows(c, state.T_world_base[c.frame], state.T_base_lidar[c.lidar]), c.frame, c.lidar);
-  for (const auto& c : problem.edges) all.emplace_back(edge_rows(c, state.T_world_base[c.frame], state.T_base_lidar[c.lidar]), c.frame, c.lidar);
+  for (const auto& c : problem.planes)
+    all.emplace_back(plane_rows(c, state.T_world_base[c.frame], state.T_base_lidar[c.lidar]), c.frame, c.lidar);
+  for (const auto& c : problem.edges)
+    all.emplace_back(edge_rows(c, state.T_world_base[c.frame], state.T_base_lidar[c.lidar]), c.frame, c.lidar);
   J = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(2 * all.size()), layout.size);
   r = Eigen::VectorXd::Zero(J.rows());
   Eigen::Index row = 0;
@@ -195,7 +197,7 @@ TEST(Marginalization, ShiftReindexesThePriorAndKeepsItsValue) {
   EXPECT_TRUE(problem.planes.empty() && problem.edges.empty());
   EXPECT_EQ(problem.prior.variables[0], (VariableId{VariableId::Kind::kPose, 0}));
   EXPECT_LT((prior_residual(problem.prior, state) - before).norm(), 1e-12);
-  EXPECT_LT((before - prior.residual).norm(), 1e-12);  // dx = 0 at the linearization point
+  EXPECT_LT((before - prior.residual).norm(), 1e-12);                                          // dx = 0 at the linearization point
   EXPECT_THROW(shift_window(problem, state, w.problem.prior, newest), std::invalid_argument);  // still holds pose 0
 }
 
@@ -220,7 +222,8 @@ TEST(Marginalization, SlidingThroughASequenceKeepsTheTruth) {
     EXPECT_TRUE(solution.converged) << window;
     EXPECT_LT(test::distance(solution.state.T_base_lidar[1], aux), 1e-6) << window;
     for (int i = 0; i < 3; ++i)
-      EXPECT_LT(test::distance(solution.state.T_world_base[static_cast<std::size_t>(i)], true_pose(window + i)), 1e-6) << window << " " << i;
+      EXPECT_LT(test::distance(solution.state.T_world_base[static_cast<std::size_t>(i)], true_pose(window + i)), 1e-6)
+          << window << " " << i;
     EXPECT_EQ(problem.prior.variables.empty(), window == 0);
     state = solution.state;
     LinearPrior prior = marginalize_frame(problem, state, 0, 0.1);

@@ -1,11 +1,15 @@
-// Odometry on real data: BALM's Ouster keyframes full20.. (0.5 s apart,
+// Odometry on real data: BALM's Ouster keyframes full20..full119 (0.5 s apart,
 // already deskewed, no ring or time fields, so the model-free front end runs)
 // against the authors' reference poses (LiDAR-inertial bundle adjustment, ~2 cm
-// noise). Checks every consecutive pair: no lost pair (> 0.2 m or > 2 deg off)
-// and mean relative errors within the bounds measured with margin.
+// noise). Checks every consecutive pair: none off (> 0.1 m or > 1-2 deg)
+// unless its later frame is flagged suspect or lost, and mean relative errors
+// within the bounds measured with margin.
 #include <cmath>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <numbers>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -15,6 +19,7 @@
 #include "mlidar/io/point_table.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/slam/odometry.hpp"
+#include "pose_error.hpp"
 #include "test_support.hpp"
 
 namespace mlidar::test {
@@ -24,61 +29,160 @@ constexpr int kFirstFrame = 20;  // the reference poses start at frame 0
 // full20 .. full49, all 30 keyframes. Measured 2026-11-23: ATE 0.0072 m, mean
 // pair error 0.0052 m / 0.053 deg, worst pair 0.012 m / 0.13 deg. Pairs 45-46
 // and 48-49 turn 21 and 11 deg: before registrations had to be tight to be
-// trusted (OdometryConfig::trusted_mean_residual_m) they settled 12 deg off.
+// trusted (TrustConfig::max_mean_residual_m) they settled 12 deg off.
 constexpr int kFrames = 30;
 
-struct PairErrors {
-  double mean_translation_m = 0.0;
-  double mean_rotation_deg = 0.0;
-  int lost = 0;
+/// Frame k -> k+1 against the reference: E = (T_gt_k^-1 T_gt_k+1)^-1 (T_est_k^-1 T_est_k+1).
+struct PairError {
+  double translation_m = 0.0;
+  double rotation_deg = 0.0;
+  bool flagged = false;  ///< the later frame is suspect or lost
 };
 
-/// E = (T_gt_i^-1 T_gt_i+1)^-1 (T_est_i^-1 T_est_i+1) for consecutive frames.
-PairErrors pair_errors(const std::vector<SE3>& gt, const std::vector<SE3>& est) {
-  PairErrors out;
-  const std::size_t pairs = gt.size() - 1;
-  for (std::size_t i = 0; i < pairs; ++i) {
-    const SE3 error = (gt[i].inverse() * gt[i + 1]).inverse() * (est[i].inverse() * est[i + 1]);
-    const double t = error.translation().norm();
-    const double r = so3_log(error.rotation()).norm() * 180.0 / std::numbers::pi;
-    out.mean_translation_m += t / static_cast<double>(pairs);
-    out.mean_rotation_deg += r / static_cast<double>(pairs);
-    if (t > 0.2 || r > 2.0) ++out.lost;
+struct BalmRun {
+  std::vector<SE3> gt, est;
+  std::vector<PairError> pairs;
+  std::vector<bool> suspect_frames;
+  std::vector<std::size_t> map_sizes;  ///< plane map points after each frame
+  int lost = 0;
+  int suspect = 0;
+
+  double mean_translation_m() const { return mean([](const PairError& p) { return p.translation_m; }); }
+  double mean_rotation_deg() const { return mean([](const PairError& p) { return p.rotation_deg; }); }
+  /// Pairs off by more than either bound whose later frame is not flagged.
+  int unflagged_beyond(double translation_m, double rotation_deg) const {
+    int count = 0;
+    for (const PairError& p : pairs) count += !p.flagged && (p.translation_m > translation_m || p.rotation_deg > rotation_deg) ? 1 : 0;
+    return count;
   }
-  return out;
+
+ private:
+  template <typename Field>
+  double mean(Field field) const {
+    double sum = 0.0;
+    for (const PairError& p : pairs) sum += field(p);
+    return sum / static_cast<double>(pairs.size());
+  }
+};
+
+/// Odometry over the keyframes first, first + step, ... (count of them), `step` x 0.5 s apart.
+/// `alter` may change a keyframe's scan (by its BALM index) before it is processed.
+BalmRun run_balm(int first, int step, int count, const slam::OdometryConfig& config = {},
+                 const std::function<void(int, Scan&)>& alter = {}) {
+  const auto folder = shared_data() / "real" / "balm_ouster";
+  Trajectory reference = io::read_balm_poses(folder / "alidarPose_0-49.csv");
+  for (const StampedPose& pose : io::read_balm_poses(folder / "alidarPose_50-119.csv").poses) reference.poses.push_back(pose);
+  EXPECT_GE(reference.size(), static_cast<std::size_t>(first + step * (count - 1) + 1));
+  slam::Odometry odometry(config, {{"ouster", LidarModel{}, SE3::identity()}});
+  BalmRun run;
+  std::vector<bool> flagged;
+  for (int k = 0; k < count; ++k) {
+    const int index = first + step * k;
+    const auto path = folder / "frames" / ("full" + std::to_string(index) + ".pcd");
+    Frame frame;
+    frame.stamp = 0.5 * step * k;
+    frame.scans.push_back(io::to_scan(io::read_cloud(path).table, path.string()));
+    frame.scans.back().stamp = frame.stamp;
+    if (alter) alter(index, frame.scans.back());
+    const slam::FrameResult result = odometry.process(frame);
+    run.lost += result.lost() ? 1 : 0;
+    run.suspect += result.suspect() ? 1 : 0;
+    flagged.push_back(result.flagged());
+    run.suspect_frames.push_back(result.suspect());
+    run.map_sizes.push_back(odometry.plane_map().points().size());
+    run.est.push_back(result.T_world_base);
+    run.gt.push_back(reference.poses[static_cast<std::size_t>(index)].T_world_base);
+  }
+  for (std::size_t i = 0; i + 1 < run.gt.size(); ++i) {
+    const SE3 error = (run.gt[i].inverse() * run.gt[i + 1]).inverse() * (run.est[i].inverse() * run.est[i + 1]);
+    run.pairs.push_back({error.translation().norm(), test::rotation_angle_deg(error), flagged[i + 1]});
+  }
+  return run;
+}
+
+double ate_m(const BalmRun& run) {
+  const auto alignment = eval::compute_alignment(eval::AlignMode::kSe3, run.gt, run.est, "estimate");
+  std::vector<SE3> aligned;
+  for (const SE3& T : run.est) aligned.push_back(alignment.apply(T));
+  return eval::compute_ate(run.gt, aligned).translation_m.rmse;
+}
+
+void print(const char* name, const BalmRun& run) {
+  std::cout << name << ": ATE " << ate_m(run) << " m, pair error " << run.mean_translation_m() << " m / " << run.mean_rotation_deg()
+            << " deg, " << run.suspect << " suspect, " << run.lost << " lost\n";
+  for (std::size_t i = 0; i < run.pairs.size(); ++i)
+    if (run.pairs[i].translation_m > 0.1 || run.pairs[i].rotation_deg > 1.0)
+      std::cout << "  pair " << i << ": " << run.pairs[i].translation_m << " m " << run.pairs[i].rotation_deg << " deg"
+                << (run.pairs[i].flagged ? " (flagged)" : "") << '\n';
 }
 
 TEST(OdometryReal, BalmOusterKeyframesFollowTheReferencePoses) {
   MLIDAR_REQUIRE_SHARED_DATA();
-  const auto folder = shared_data() / "real" / "balm_ouster";
-  const Trajectory reference = io::read_balm_poses(folder / "alidarPose_0-49.csv");
-  ASSERT_GE(reference.size(), static_cast<std::size_t>(kFirstFrame + kFrames));
-  slam::Odometry odometry({}, {{"ouster", LidarModel{}, SE3::identity()}});
-  std::vector<SE3> gt, est;
-  int lost_frames = 0;
-  for (int k = 0; k < kFrames; ++k) {
-    const auto path = folder / "frames" / ("full" + std::to_string(kFirstFrame + k) + ".pcd");
-    Frame frame;
-    frame.stamp = 0.5 * k;
-    frame.scans.push_back(io::to_scan(io::read_cloud(path).table, path.string()));
-    frame.scans.back().stamp = frame.stamp;
-    const slam::FrameResult result = odometry.process(frame);
-    lost_frames += result.lost ? 1 : 0;
-    est.push_back(result.T_world_base);
-    gt.push_back(reference.poses[static_cast<std::size_t>(kFirstFrame + k)].T_world_base);
-  }
-  const PairErrors errors = pair_errors(gt, est);
-  const auto alignment = eval::compute_alignment(eval::AlignMode::kSe3, gt, est, "estimate");
-  std::vector<SE3> aligned;
-  for (const SE3& T : est) aligned.push_back(alignment.apply(T));
-  const double ate_m = eval::compute_ate(gt, aligned).translation_m.rmse;
-  std::cout << "balm frames " << kFirstFrame << ".." << kFirstFrame + kFrames - 1 << ": ATE " << ate_m << " m, pair error "
-            << errors.mean_translation_m << " m / " << errors.mean_rotation_deg << " deg, lost pairs " << errors.lost << '\n';
-  EXPECT_EQ(lost_frames, 0);
-  EXPECT_EQ(errors.lost, 0);
-  EXPECT_LT(errors.mean_translation_m, 0.015);
-  EXPECT_LT(errors.mean_rotation_deg, 0.15);
-  EXPECT_LT(ate_m, 0.02);
+  const BalmRun run = run_balm(kFirstFrame, 1, kFrames);
+  print("balm frames 20..49", run);
+  EXPECT_EQ(run.lost, 0);
+  EXPECT_EQ(run.suspect, 0);
+  EXPECT_EQ(run.unflagged_beyond(0.2, 2.0), 0);
+  EXPECT_LT(run.mean_translation_m(), 0.015);
+  EXPECT_LT(run.mean_rotation_deg(), 0.15);
+  EXPECT_LT(ate_m(run), 0.02);
+}
+
+// Frames 50..60, started at 50: keyframe 56 registered from its prediction
+// settles 2.5 deg / 0.3 m off with 93 % of its features matched, at a mean |r|
+// 3.7 x that of the frames before (measured 2026-12-02). Judged against the
+// recent frames it is retried and the retries find the right alignment.
+TEST(OdometryReal, BalmAlignmentThatFitsWorseThanTheRecentFramesIsRetried) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  const BalmRun run = run_balm(50, 1, 11);
+  print("balm frames 50..60", run);
+  EXPECT_EQ(run.unflagged_beyond(0.1, 1.0), 0);
+  EXPECT_EQ(run.lost, 0);
+  EXPECT_LT(run.mean_translation_m(), 0.015);
+
+  // The hazard this guards against: without the relative bound the same frames slide unflagged.
+  slam::OdometryConfig absolute_only;
+  absolute_only.trust.residual_ratio = std::numeric_limits<double>::infinity();
+  const BalmRun unguarded = run_balm(50, 1, 11, absolute_only);
+  print("balm frames 50..60, absolute bounds only", unguarded);
+  EXPECT_GT(unguarded.unflagged_beyond(0.1, 1.0), 0);
+}
+
+// A keyframe that fits clearly worse than the ones before (its points moved by
+// 12 cm noise) is suspect: its pose is kept, its points stay out of the map, and
+// the next keyframe is trusted again.
+TEST(OdometryReal, AKeyframeThatFitsWorseIsSuspectAndKeptOutOfTheMap) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  std::mt19937 rng(7);
+  const auto noisy = [&rng](int index, Scan& scan) {
+    if (index != 25) return;
+    std::normal_distribution<float> noise(0.0F, 0.12F);
+    for (Eigen::Vector3f& p : scan.points)
+      for (int axis = 0; axis < 3; ++axis) p[axis] += noise(rng);  // one draw per statement: the same on every compiler
+  };
+  const BalmRun run = run_balm(20, 1, 8, {}, noisy);
+  print("balm frames 20..27, 25 noisy", run);
+  const std::vector<bool> expected = {false, false, false, false, false, true, false, false};
+  EXPECT_EQ(run.suspect_frames, expected);
+  EXPECT_EQ(run.lost, 0);
+  EXPECT_EQ(run.map_sizes[5], run.map_sizes[4]) << "the suspect frame's points entered the map";
+  EXPECT_GT(run.map_sizes[6], run.map_sizes[5]);
+  EXPECT_LT(run.pairs[5].translation_m + run.pairs[6].translation_m, 0.1);  // its pose is still a fair guess
+}
+
+// Every second keyframe, 1 s apart (turns up to ~40 deg): the constant-velocity
+// prediction is often tens of degrees and metres off and the retries decide.
+// Started at 22, keyframe 32 settled 2.1 m off (0.09 deg) unflagged when the
+// retries started from the prediction only and stopped at the first to pass;
+// started at 24, four frames were lost (measured 2026-12-02). The retries now
+// also start from the previous pose, and all run: the tightest is kept.
+TEST(OdometryReal, BalmKeyframesOneSecondApartAreRightOrFlagged) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  const BalmRun run = run_balm(22, 2, 6);
+  print("balm frames 22..32 step 2", run);
+  EXPECT_EQ(run.unflagged_beyond(0.1, 2.0), 0);
+  EXPECT_EQ(run.lost, 0);
+  EXPECT_LT(ate_m(run), 0.05);
 }
 
 }  // namespace

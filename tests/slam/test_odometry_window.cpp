@@ -64,8 +64,8 @@ WindowRun run_window(int frames, double odometry_error_m, double odometry_error_
     // The odometry's pose: the truth with an independent error (the first p frames exact: they fix the gauge).
     const SE3 odometry = k < config.pivot ? true_pose(k) : test::perturb(true_pose(k), odometry_error_m, odometry_error_rad, rng);
     run.odometry.push_back(odometry);
-    const OdometryWindowUpdate update = window.add(static_cast<std::size_t>(k), sample_features(scene, true_pose(k), 1500, 0.02, rng),
-                                                   odometry, SE3::identity());
+    const OdometryWindowUpdate update =
+        window.add(static_cast<std::size_t>(k), sample_features(scene, true_pose(k), 1500, 0.02, rng), odometry, SE3::identity());
     EXPECT_EQ(update.latest.frame, static_cast<std::size_t>(k));
     if (update.settled) {
       EXPECT_TRUE(run.settled.emplace(update.settled->frame, update.settled->T_world_base).second) << k;

@@ -34,7 +34,12 @@ TEST(Residuals, PlaneJacobianMatchesNumeric) {
     Mat36 J;
     plane_residual(plane, T * p, r, J);
     EXPECT_NEAR(r.norm(), std::abs(plane.normal.dot(T * p) + plane.offset), 1e-9);  // |r| = point-plane distance
-    const auto f = [&](const SE3& X) { Vec3 rr; Mat36 JJ; plane_residual(plane, X * p, rr, JJ); return Eigen::VectorXd(rr); };
+    const auto f = [&](const SE3& X) {
+      Vec3 rr;
+      Mat36 JJ;
+      plane_residual(plane, X * p, rr, JJ);
+      return Eigen::VectorXd(rr);
+    };
     EXPECT_LT((numeric_jacobian(f, T) - J).norm(), 1e-5 * (1.0 + J.norm())) << trial;
   }
 }
@@ -71,7 +76,8 @@ TEST(Residuals, EdgeResidualIsDistanceToLineAndJacobianMatches) {
     EXPECT_NEAR(planes.first.normal.dot(planes.second.normal), 0.0, 1e-12);
     const auto f = [&](const SE3& X) {
       Eigen::VectorXd r(6);
-      Vec3 r1; Mat36 J1;
+      Vec3 r1;
+      Mat36 J1;
       plane_residual(planes.first, X * p, r1, J1);
       r.head<3>() = r1;
       plane_residual(planes.second, X * p, r1, J1);
@@ -81,7 +87,8 @@ TEST(Residuals, EdgeResidualIsDistanceToLineAndJacobianMatches) {
     const double line_distance = ((q - a) - u.dot(q - a) * u).norm();
     EXPECT_NEAR(f(T).norm(), line_distance, 1e-9);
     Eigen::MatrixXd J(6, 6);
-    Vec3 r1; Mat36 J1;
+    Vec3 r1;
+    Mat36 J1;
     plane_residual(planes.first, q, r1, J1);
     J.topRows<3>() = J1;
     plane_residual(planes.second, q, r1, J1);
@@ -109,10 +116,12 @@ TEST(VoxelMap, NearestMatchesBruteForceWithinOneVoxel) {
     const float radius_sq = 1.0F;  // within one voxel, the 27-voxel search is exact
     const int count = map.nearest(q, 5, radius_sq, near);
     std::vector<float> brute;
-    for (const auto& p : points) if ((p - q).squaredNorm() <= radius_sq) brute.push_back((p - q).squaredNorm());
+    for (const auto& p : points)
+      if ((p - q).squaredNorm() <= radius_sq) brute.push_back((p - q).squaredNorm());
     std::sort(brute.begin(), brute.end());
     ASSERT_EQ(count, static_cast<int>(std::min<std::size_t>(5, brute.size())));
-    for (int k = 0; k < count; ++k) EXPECT_FLOAT_EQ((near[static_cast<std::size_t>(k)] - q).squaredNorm(), brute[static_cast<std::size_t>(k)]);
+    for (int k = 0; k < count; ++k)
+      EXPECT_FLOAT_EQ((near[static_cast<std::size_t>(k)] - q).squaredNorm(), brute[static_cast<std::size_t>(k)]);
   }
 }
 

@@ -4,8 +4,8 @@
 // information's null direction in a scene of vertical walls.
 #include <random>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "mlidar/slam/window_linearize.hpp"
 #include "mlidar/slam/window_solver.hpp"
@@ -156,7 +156,7 @@ TEST(WindowSolver, VerticalWallsLeaveTheExtrinsicZShiftUnobservable) {
   EXPECT_LT(eigen.eigenvalues()(0), 1e-9 * eigen.eigenvalues()(5));
   EXPECT_GT(eigen.eigenvalues()(1), 1e-3 * eigen.eigenvalues()(5));  // only one direction is lost
   EXPECT_GT(std::abs(eigen.eigenvectors().col(0)(2)), 1.0 - 1e-9);   // translation along z
-  EXPECT_FALSE(solution.covariance_valid);  // pose 1's z is unobservable too
+  EXPECT_FALSE(solution.covariance_valid);                           // pose 1's z is unobservable too
   EXPECT_LT(solution.final_cost, 1e-14);
 }
 

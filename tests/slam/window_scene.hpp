@@ -46,7 +46,8 @@ inline WindowProblem observe(const WindowScene& scene, const WindowState& truth,
   WindowProblem problem;
   for (int i = 0; i < static_cast<int>(truth.T_world_base.size()); ++i)
     for (int j = 0; j < static_cast<int>(truth.T_base_lidar.size()); ++j) {
-      const SE3 T_lidar_world = (truth.T_world_base[static_cast<std::size_t>(i)] * truth.T_base_lidar[static_cast<std::size_t>(j)]).inverse();
+      const SE3 T_lidar_world =
+          (truth.T_world_base[static_cast<std::size_t>(i)] * truth.T_base_lidar[static_cast<std::size_t>(j)]).inverse();
       const Vec3 origin = T_lidar_world.inverse().translation();
       for (int k = 0; k < per_lidar; ++k) {
         const Vec3 near = origin + Vec3(spread(rng), spread(rng), spread(rng));

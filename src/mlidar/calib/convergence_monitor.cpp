@@ -10,12 +10,13 @@
 #include <Eigen/Eigenvalues>
 
 #include "mlidar/core/conversions.hpp"
+#include "mlidar/core/median.hpp"
 #include "mlidar/core/rotation_average.hpp"
 
 namespace mlidar::calib {
 namespace {
 
-constexpr std::array<const char*, 6> kAxisNames = {"translation x",     "translation y",     "translation z",
+constexpr std::array<const char*, 6> kAxisNames = {"translation x",    "translation y",    "translation z",
                                                    "rotation about x", "rotation about y", "rotation about z"};
 constexpr double kSingleAxisShare = 0.9;  ///< squared share for a single-axis name
 constexpr double kListedShare = 0.1;      ///< squared share for a component to be listed
@@ -35,17 +36,9 @@ Quat karcher_mean(std::span<const Quat> rotations) {
 
 bool finite(const SE3& T) { return T.rotation().coeffs().allFinite() && T.translation().allFinite(); }
 
-double median(std::vector<double> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  if (values.size() % 2 == 1) return *middle;
-  return 0.5 * (*middle + *std::max_element(values.begin(), middle));
-}
-
 constexpr double kMadToSigma = 1.4826;  ///< MAD of a normal distribution times this is its sigma
 /// Robust sigma floor of the accepted estimates, [t m, r rad]: agreeing windows are never trimmed for mm scatter.
 Vec6 robust_sigma_floor() { return (Vec6() << Vec3::Constant(0.002), Vec3::Constant(deg_to_rad(0.02))).finished(); }
-
 
 }  // namespace
 
@@ -123,15 +116,18 @@ std::vector<std::size_t> robust_inliers(std::span<const Vec6> deviations, double
 
 std::string_view to_string(CalibrationMode mode) {
   switch (mode) {
-    case CalibrationMode::calibrating: return "calibrating";
-    case CalibrationMode::converged: return "converged";
+    case CalibrationMode::calibrating:
+      return "calibrating";
+    case CalibrationMode::converged:
+      return "converged";
   }
   return "unknown";
 }
 
 ConvergenceMonitor::ConvergenceMonitor(std::vector<SE3> initial, ConvergenceConfig config) : config_(config) {
   if (initial.empty() || config_.accepted_needed < 2 || !(config_.lambda_calib > 0.0) || !(config_.min_autocorrelation_time >= 1.0)) {
-    throw std::invalid_argument("ConvergenceMonitor: needs >= 1 LiDAR, accepted_needed >= 2, lambda_calib > 0, min_autocorrelation_time >= 1");
+    throw std::invalid_argument(
+        "ConvergenceMonitor: needs >= 1 LiDAR, accepted_needed >= 2, lambda_calib > 0, min_autocorrelation_time >= 1");
   }
   for (const SE3& T : initial) {
     LidarCalibrationState state;
@@ -152,9 +148,8 @@ WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_bas
   }
   // Lines 3-4: the degeneracy factor.
   state.weak = weak_directions(information, config_.lambda_calib);
-  verdict.lambda_min = Eigen::SelfAdjointEigenSolver<Mat6>(0.5 * (information + information.transpose()),
-                                                           Eigen::EigenvaluesOnly)
-                           .eigenvalues()(0);
+  verdict.lambda_min =
+      Eigen::SelfAdjointEigenSolver<Mat6>(0.5 * (information + information.transpose()), Eigen::EigenvaluesOnly).eigenvalues()(0);
   state.last_lambda_min = verdict.lambda_min;
   verdict.constrained = verdict.lambda_min > config_.lambda_calib;
   if (!verdict.constrained || !settled) return verdict;
@@ -183,8 +178,9 @@ WindowVerdict ConvergenceMonitor::add_window(std::size_t lidar, const SE3& T_bas
   }
   const ExtrinsicMean mean = extrinsic_mean(kept);
   state.T_base_lidar = mean.mean;
-  state.covariance_parts = calibration_covariance(mean.local_deviations, all_windows ? std::span<const Mat6>(kept_covariances) : std::span<const Mat6>(),
-                                                  config_.min_autocorrelation_time);
+  state.covariance_parts =
+      calibration_covariance(mean.local_deviations, all_windows ? std::span<const Mat6>(kept_covariances) : std::span<const Mat6>(),
+                             config_.min_autocorrelation_time);
   Vec6 bias_sd;
   bias_sd << Vec3::Constant(config_.bias_translation_sd_m), Vec3::Constant(deg_to_rad(config_.bias_rotation_sd_deg));
   state.covariance_parts.bias = bias_sd.cwiseAbs2().asDiagonal();
@@ -208,8 +204,7 @@ void ConvergenceMonitor::restart(std::size_t lidar) {
 }
 
 bool ConvergenceMonitor::all_converged() const {
-  return std::all_of(lidars_.begin(), lidars_.end(),
-                     [](const LidarCalibrationState& s) { return s.mode == CalibrationMode::converged; });
+  return std::all_of(lidars_.begin(), lidars_.end(), [](const LidarCalibrationState& s) { return s.mode == CalibrationMode::converged; });
 }
 
 }  // namespace mlidar::calib

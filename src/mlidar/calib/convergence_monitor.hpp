@@ -30,8 +30,8 @@
 namespace mlidar::calib {
 
 struct ConvergenceConfig {
-  double lambda_calib = 70.0;          ///< accept a window's estimate when lambda_min exceeds it
-  std::size_t accepted_needed = 25;    ///< L_calib: accepted estimates averaged at convergence
+  double lambda_calib = 70.0;        ///< accept a window's estimate when lambda_min exceeds it
+  std::size_t accepted_needed = 25;  ///< L_calib: accepted estimates averaged at convergence
   /// Floor of the accepted estimates' autocorrelation time in Xi_calib: the
   /// frames a window spans (N + 1), as consecutive windows share N of them.
   double min_autocorrelation_time = 1.0;
@@ -82,24 +82,24 @@ std::string_view to_string(CalibrationMode mode);
 
 struct WindowVerdict {
   double lambda_min = 0.0;
-  bool constrained = false;       ///< lambda_min > lambda_calib (line 5)
-  bool accepted = false;          ///< constrained and settled: the estimate joins L (lines 6-7)
-  bool converged_now = false;     ///< this window completed L_calib (lines 8-11)
+  bool constrained = false;    ///< lambda_min > lambda_calib (line 5)
+  bool accepted = false;       ///< constrained and settled: the estimate joins L (lines 6-7)
+  bool converged_now = false;  ///< this window completed L_calib (lines 8-11)
 };
 
 /// Per-LiDAR state of Algorithm 1.
 struct LidarCalibrationState {
   CalibrationMode mode = CalibrationMode::calibrating;
-  std::vector<SE3> accepted;            ///< the set L (cleared at restart)
+  std::vector<SE3> accepted;               ///< the set L (cleared at restart)
   std::vector<Mat6> accepted_covariances;  ///< their own covariances ([t, r local]) when given
-  SE3 T_base_lidar;                     ///< last accepted estimate; the mean once converged
-  Mat6 covariance = Mat6::Zero();       ///< Xi_calib once converged ([t additive, r local])
+  SE3 T_base_lidar;                        ///< last accepted estimate; the mean once converged
+  Mat6 covariance = Mat6::Zero();          ///< Xi_calib once converged ([t additive, r local])
   CalibrationCovariance covariance_parts;  ///< its terms once converged
   double last_lambda_min = 0.0;
-  std::size_t windows = 0;              ///< windows seen while calibrating
-  std::size_t restarts = 0;             ///< restart() calls (re-calibrations)
-  std::vector<WeakDirection> weak;      ///< of the last window's information below lambda_calib
-  std::size_t outliers = 0;             ///< accepted estimates left out of the mean at convergence
+  std::size_t windows = 0;          ///< windows seen while calibrating
+  std::size_t restarts = 0;         ///< restart() calls (re-calibrations)
+  std::vector<WeakDirection> weak;  ///< of the last window's information below lambda_calib
+  std::size_t outliers = 0;         ///< accepted estimates left out of the mean at convergence
 };
 
 class ConvergenceMonitor {

@@ -24,16 +24,15 @@ double smallest_line_angle_deg(const std::array<Plane, 3>& planes) {
 }
 
 /// Distance from `point` to the nearest of `indices`.
-double nearest_distance(std::span<const Eigen::Vector3f> points, const std::vector<std::uint32_t>& indices,
-                        const Vec3& point) {
+double nearest_distance(std::span<const Eigen::Vector3f> points, const std::vector<std::uint32_t>& indices, const Vec3& point) {
   double best = std::numeric_limits<double>::infinity();
   for (const std::uint32_t i : indices) best = std::min(best, (points[i].cast<double>() - point).squaredNorm());
   return std::sqrt(best);
 }
 
 /// Each finite point within the inlier band goes to its nearest plane.
-std::array<std::vector<std::uint32_t>, 3> assign_points_impl(std::span<const Eigen::Vector3f> points,
-                                                        const std::array<Plane, 3>& planes, double band) {
+std::array<std::vector<std::uint32_t>, 3> assign_points_impl(std::span<const Eigen::Vector3f> points, const std::array<Plane, 3>& planes,
+                                                             double band) {
   std::array<std::vector<std::uint32_t>, 3> inliers;
   for (std::size_t k = 0; k < points.size(); ++k) {
     if (!points[k].allFinite()) continue;
@@ -95,14 +94,12 @@ std::array<int, 3> orient_and_order(std::array<Plane, 3>& planes, const Vec3& up
 }
 
 std::array<double, 3> pairwise_angles_deg(const std::array<Plane, 3>& planes) {
-  auto angle = [&](int i, int j) {
-    return std::acos(std::clamp(planes[i].normal.dot(planes[j].normal), -1.0, 1.0)) / kDeg;
-  };
+  auto angle = [&](int i, int j) { return std::acos(std::clamp(planes[i].normal.dot(planes[j].normal), -1.0, 1.0)) / kDeg; };
   return {angle(0, 1), angle(0, 2), angle(1, 2)};
 }
 
-Corner find_corner(std::span<const Eigen::Vector3f> points, const std::vector<PlaneSegment>& segments,
-                   const PlanesConfig& config, const std::string& source) {
+Corner find_corner(std::span<const Eigen::Vector3f> points, const std::vector<PlaneSegment>& segments, const PlanesConfig& config,
+                   const std::string& source) {
   const int count = static_cast<int>(segments.size());
   Candidate best;
   bool found = false;
@@ -116,11 +113,9 @@ Corner find_corner(std::span<const Eigen::Vector3f> points, const std::vector<Pl
         const Vec3 o = corner_point(planes);
         for (const int s : candidate.segments) {
           candidate.support += segments[s].inliers.size();
-          candidate.near_clouds = candidate.near_clouds &&
-                                  nearest_distance(points, segments[s].inliers, o) <= config.corner_max_gap;
+          candidate.near_clouds = candidate.near_clouds && nearest_distance(points, segments[s].inliers, o) <= config.corner_max_gap;
         }
-        if (!found || candidate.rank() > best.rank() ||
-            (candidate.rank() == best.rank() && candidate.support > best.support)) {
+        if (!found || candidate.rank() > best.rank() || (candidate.rank() == best.rank() && candidate.support > best.support)) {
           best = candidate;
           found = true;
         }
@@ -130,8 +125,7 @@ Corner find_corner(std::span<const Eigen::Vector3f> points, const std::vector<Pl
   if (!found) {
     throw InputError(source, "planes",
                      "found " + std::to_string(count) + " plane(s) but no three that meet at a corner (pairwise angles >= " +
-                         std::to_string(config.min_any_angle_deg) +
-                         " deg); scan a corner of two walls and the floor, seen by both LiDARs");
+                         std::to_string(config.min_any_angle_deg) + " deg); scan a corner of two walls and the floor, seen by both LiDARs");
   }
   Corner corner;
   for (int i = 0; i < 3; ++i) corner.planes[i] = segments[best.segments[i]].fit.plane;
@@ -143,8 +137,8 @@ Corner find_corner(std::span<const Eigen::Vector3f> points, const std::vector<Pl
   return corner;
 }
 
-std::array<std::vector<std::uint32_t>, 3> assign_points(std::span<const Eigen::Vector3f> points,
-                                                        const std::array<Plane, 3>& planes, double band) {
+std::array<std::vector<std::uint32_t>, 3> assign_points(std::span<const Eigen::Vector3f> points, const std::array<Plane, 3>& planes,
+                                                        double band) {
   return assign_points_impl(points, planes, band);
 }
 

@@ -6,9 +6,11 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "mlidar/core/conversions.hpp"
+#include "mlidar/core/covariance.hpp"
 #include "mlidar/core/rotation_average.hpp"
 #include "mlidar/geometry/kdtree.hpp"
 
@@ -50,10 +52,17 @@ Mat6 inverse_psd(const Mat6& information) {
   return ridged.ldlt().solve(Mat6::Identity());
 }
 
+/// The shared-bias term of CandidateSelection, diagonal in [e_t, e_r].
+Mat6 bias_covariance(const CandidateSelection& selection) {
+  Vec6 variance;
+  variance << Vec3::Constant(selection.bias_translation_sd_m * selection.bias_translation_sd_m),
+      Vec3::Constant(std::pow(deg_to_rad(selection.bias_rotation_sd_deg), 2));
+  return variance.asDiagonal();
+}
+
 }  // namespace
 
-double overlap_factor(std::span<const Eigen::Vector3f> points_a, std::span<const Eigen::Vector3f> points_b,
-                      double radius_m) {
+double overlap_factor(std::span<const Eigen::Vector3f> points_a, std::span<const Eigen::Vector3f> points_b, double radius_m) {
   std::vector<Eigen::Vector3f> a = finite_points(points_a);
   std::vector<Eigen::Vector3f> b = finite_points(points_b);
   if (a.empty() || b.empty()) return 0.0;
@@ -64,8 +73,7 @@ double overlap_factor(std::span<const Eigen::Vector3f> points_a, std::span<const
   return ratio_a * ratio_b;  // eq 3.14
 }
 
-Mat6 extrinsic_information(const Mat6& registration_hessian, double residual_variance, const SE3& T_world_base,
-                           const SE3& T_base_target) {
+Mat6 extrinsic_information(const Mat6& registration_hessian, double residual_variance, const SE3& T_world_base, const SE3& T_base_target) {
   Mat6 J = Mat6::Zero();
   J.topLeftCorner<3, 3>() = Mat3::Identity();
   J.topRightCorner<3, 3>() = -hat(T_base_target.translation());
@@ -75,8 +83,7 @@ Mat6 extrinsic_information(const Mat6& registration_hessian, double residual_var
   return M_inv.transpose() * registration_hessian * M_inv / std::max(residual_variance, 1e-12);
 }
 
-CandidateAverage average_best_candidates(std::span<const ExtrinsicCandidate> candidates,
-                                         const CandidateSelection& selection) {
+CandidateAverage average_best_candidates(std::span<const ExtrinsicCandidate> candidates, const CandidateSelection& selection) {
   if (candidates.empty()) throw std::invalid_argument("average_best_candidates: no candidates");
   std::vector<std::size_t> order(candidates.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -109,11 +116,39 @@ CandidateAverage average_best_candidates(std::span<const ExtrinsicCandidate> can
   // and odometry errors, so their mean is not n times better than one of them.
   if (keep > 1) out.covariance_spread = scatter / (static_cast<double>(keep) - 1.0);
   out.covariance_icp = inverse_psd(information);
-  Vec6 bias_variance;
-  bias_variance << Vec3::Constant(selection.bias_translation_sd_m * selection.bias_translation_sd_m),
-      Vec3::Constant(std::pow(deg_to_rad(selection.bias_rotation_sd_deg), 2));
-  out.covariance_bias = bias_variance.asDiagonal();
+  out.covariance_bias = bias_covariance(selection);
   out.covariance = out.covariance_spread + out.covariance_icp + out.covariance_bias;
+  return out;
+}
+
+InformationFusion fuse_by_information(std::span<const ExtrinsicCandidate> candidates, const SE3& about,
+                                      const CandidateSelection& selection) {
+  if (candidates.empty()) throw std::invalid_argument("fuse_by_information: no candidates");
+  InformationFusion out;
+  out.T_base_target = about;
+  for (const auto& c : candidates) out.information += c.information;
+  const Mat6 covariance = inverse_psd(out.information);
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    Vec6 gradient = Vec6::Zero();
+    for (const auto& c : candidates) gradient += c.information * deviation(out.T_base_target, c.T_base_target);
+    const Vec6 step = covariance * gradient;
+    out.T_base_target = SE3(out.T_base_target.rotation() * so3_exp(step.tail<3>()), out.T_base_target.translation() + step.head<3>());
+    if (step.norm() < 1e-10) break;
+  }
+  double chi2 = 0.0;
+  for (const auto& c : candidates) {
+    const Vec6 e = deviation(out.T_base_target, c.T_base_target);
+    chi2 += e.dot(c.information * e);
+  }
+  const double dof = 6.0 * static_cast<double>(candidates.size() - 1);
+  out.chi2_per_dof = dof > 0.0 ? chi2 / dof : 0.0;
+  out.covariance = covariance * std::max(1.0, out.chi2_per_dof) + bias_covariance(selection);
+  out.translation_sd_m = largest_sd(out.covariance.topLeftCorner<3, 3>());
+  out.rotation_sd_deg = rad_to_deg(largest_sd(out.covariance.bottomRightCorner<3, 3>()));
+  const Eigen::SelfAdjointEigenSolver<Mat3> translation(out.information.topLeftCorner<3, 3>());
+  const Vec3 spread = translation.eigenvalues();
+  out.translation_observability = spread(2) > 0.0 ? spread(0) / spread(2) : 0.0;
+  out.weak_direction = translation.eigenvectors().col(0);
   return out;
 }
 

@@ -60,8 +60,7 @@ Mat6 local_covariance_from_left_information(const SE3& T, const Mat6& informatio
   return M * (residual_variance * pseudo_inverse(information)) * M.transpose();
 }
 
-CalibrationCovariance calibration_covariance(std::span<const Vec6> deviations, std::span<const Mat6> window_covariances,
-                                             double min_tau) {
+CalibrationCovariance calibration_covariance(std::span<const Vec6> deviations, std::span<const Mat6> window_covariances, double min_tau) {
   const std::size_t n = deviations.size();
   if (n < 2) throw std::invalid_argument("calibration_covariance: needs at least 2 estimates");
   if (!window_covariances.empty() && window_covariances.size() != n)

@@ -36,10 +36,10 @@ double integrated_autocorrelation_time(std::span<const Vec6> deviations);
 Mat6 local_covariance_from_left_information(const SE3& T, const Mat6& information, double residual_variance);
 
 struct CalibrationCovariance {
-  Mat6 total = Mat6::Zero();       ///< spread + windows + bias
-  Mat6 spread = Mat6::Zero();      ///< S tau / n
-  Mat6 windows = Mat6::Zero();     ///< mean of the windows' own covariances
-  Mat6 bias = Mat6::Zero();        ///< shared-error floor (ConvergenceConfig::bias_*), added by the monitor
+  Mat6 total = Mat6::Zero();          ///< spread + windows + bias
+  Mat6 spread = Mat6::Zero();         ///< S tau / n
+  Mat6 windows = Mat6::Zero();        ///< mean of the windows' own covariances
+  Mat6 bias = Mat6::Zero();           ///< shared-error floor (ConvergenceConfig::bias_*), added by the monitor
   double autocorrelation_time = 1.0;  ///< tau used (>= min_tau)
 };
 
@@ -48,7 +48,6 @@ struct CalibrationCovariance {
 /// unknown. tau is at least `min_tau` (e.g. N + 1: the overlap of consecutive
 /// windows makes rho_k >= (N + 1 - k) / (N + 1) for shared-frame noise).
 /// Throws std::invalid_argument for fewer than 2 deviations or a size mismatch.
-CalibrationCovariance calibration_covariance(std::span<const Vec6> deviations, std::span<const Mat6> window_covariances,
-                                             double min_tau);
+CalibrationCovariance calibration_covariance(std::span<const Vec6> deviations, std::span<const Mat6> window_covariances, double min_tau);
 
 }  // namespace mlidar::calib

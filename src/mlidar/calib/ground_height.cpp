@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "mlidar/core/conversions.hpp"
+#include "mlidar/core/median.hpp"
 
 namespace mlidar::calib {
 namespace {
@@ -33,12 +34,6 @@ std::optional<PlaneSegment> ground_plane(std::span<const Eigen::Vector3f> points
   return std::nullopt;
 }
 
-double median(std::vector<double> values) {
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
-
 }  // namespace
 
 std::optional<double> ground_height_shift(const Scan& scan_a, const Scan& scan_b, const SE3& T_a_b, const Vec3& axis_a,
@@ -55,8 +50,8 @@ std::optional<double> ground_height_shift(const Scan& scan_a, const Scan& scan_b
   return -plane_a.signed_distance(ground_b->fit.centroid) / plane_a.normal.dot(axis);
 }
 
-GroundHeightResult height_from_ground(std::span<const Scan> scans_a, std::span<const Scan> scans_b, const SE3& T_a_b,
-                                      const Vec3& axis_a, const GroundHeightConfig& config) {
+GroundHeightResult height_from_ground(std::span<const Scan> scans_a, std::span<const Scan> scans_b, const SE3& T_a_b, const Vec3& axis_a,
+                                      const GroundHeightConfig& config) {
   if (scans_a.size() != scans_b.size()) throw std::invalid_argument("height_from_ground: scan counts differ");
   std::vector<double> shifts;
   for (std::size_t i = 0; i < scans_a.size(); ++i) {
@@ -64,10 +59,10 @@ GroundHeightResult height_from_ground(std::span<const Scan> scans_a, std::span<c
   }
   GroundHeightResult result{T_a_b, shifts.size(), 0.0, 0.0};
   if (shifts.empty()) return result;
-  result.shift_m = median(shifts);
+  result.shift_m = upper_median(shifts);
   std::vector<double> deviations;
   for (const double s : shifts) deviations.push_back(std::abs(s - result.shift_m));
-  result.spread_m = 1.4826 * median(deviations);
+  result.spread_m = 1.4826 * upper_median(deviations);
   result.T_a_b = SE3(T_a_b.rotation(), T_a_b.translation() + result.shift_m * axis_a.normalized());
   return result;
 }

@@ -18,8 +18,8 @@
 namespace mlidar::calib {
 
 struct GroundUpConfig {
-  double max_angle_rad = 0.6;   ///< ~34 deg: twice the thesis's shock tilt
-  double min_below_m = 0.3;     ///< the sensor is at least this high above the ground
+  double max_angle_rad = 0.6;  ///< ~34 deg: twice the thesis's shock tilt
+  double min_below_m = 0.3;    ///< the sensor is at least this high above the ground
   double inlier_distance_m = 0.1;
   std::size_t min_inliers = 200;
 };

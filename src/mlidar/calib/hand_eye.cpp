@@ -13,10 +13,9 @@ namespace mlidar::calib {
 namespace {
 
 void validate(const HandEyeConfig& c) {
-  const bool ok = c.screw_angle_tolerance_rad > 0 && c.screw_pitch_tolerance_m > 0 && c.min_axis_angle_rad > 0 &&
-                  c.min_pairs >= 2 && c.min_rotation_rad >= 0 && c.planar_singular_ratio > 0 &&
-                  c.planar_singular_ratio < 1 && c.degenerate_condition > 0 && c.refine_iterations >= 0 &&
-                  c.unobservable_variance > 0;
+  const bool ok = c.screw_angle_tolerance_rad > 0 && c.screw_pitch_tolerance_m > 0 && c.min_axis_angle_rad > 0 && c.min_pairs >= 2 &&
+                  c.min_rotation_rad >= 0 && c.planar_singular_ratio > 0 && c.planar_singular_ratio < 1 && c.degenerate_condition > 0 &&
+                  c.refine_iterations >= 0 && c.unobservable_variance > 0;
   if (!ok) throw std::invalid_argument("HandEyeConfig: a tolerance is out of range (all > 0, ratio < 1, min_pairs >= 2)");
 }
 
@@ -29,8 +28,7 @@ Residuals residuals(std::span<const MotionPair> pairs, const SE3& X) {
   Residuals r;
   for (const MotionPair& p : pairs) {
     const Vec3 e_r = so3_log(p.A.rotation()) - X.rotation() * so3_log(p.B.rotation());
-    const Vec3 e_t = (p.A.rotation_matrix() - Mat3::Identity()) * X.translation() - X.rotation() * p.B.translation() +
-                     p.A.translation();
+    const Vec3 e_t = (p.A.rotation_matrix() - Mat3::Identity()) * X.translation() - X.rotation() * p.B.translation() + p.A.translation();
     r.rotation_sq += e_r.squaredNorm();
     r.translation_sq += e_t.squaredNorm();
   }
@@ -91,10 +89,14 @@ Mat6 refine(std::span<const MotionPair> pairs, SE3& X, const HandEyeConfig& conf
 
 std::string_view to_string(HandEyeVerdict verdict) {
   switch (verdict) {
-    case HandEyeVerdict::ok: return "ok";
-    case HandEyeVerdict::planar_motion: return "planar_motion";
-    case HandEyeVerdict::degenerate_motion: return "degenerate_motion";
-    case HandEyeVerdict::too_few_pairs: return "too_few_pairs";
+    case HandEyeVerdict::ok:
+      return "ok";
+    case HandEyeVerdict::planar_motion:
+      return "planar_motion";
+    case HandEyeVerdict::degenerate_motion:
+      return "degenerate_motion";
+    case HandEyeVerdict::too_few_pairs:
+      return "too_few_pairs";
   }
   return "unknown";
 }

@@ -48,17 +48,17 @@ struct ScrewResidual {
 
 struct HandEyeResult {
   HandEyeVerdict verdict = HandEyeVerdict::too_few_pairs;
-  SE3 T_a_b;                      ///< the estimate (identity when too_few_pairs / degenerate)
-  Mat6 covariance = Mat6::Zero(); ///< [t, r], rotation as a left perturbation Exp(d) R
+  SE3 T_a_b;                         ///< the estimate (identity when too_few_pairs / degenerate)
+  Mat6 covariance = Mat6::Zero();    ///< [t, r], rotation as a left perturbation Exp(d) R
   std::vector<ScrewResidual> screw;  ///< one per input pair
   std::size_t pairs_used = 0;
   std::size_t pairs_rejected = 0;
   std::array<double, 4> singular_values{};  ///< eq 3.7 Q_N, descending
-  bool t_z_observable = true;     ///< false under planar motion (eq 3.10 sets t_z = 0)
-  Vec3 planar_axis_a = Vec3::UnitZ();  ///< common rotation axis in {a} (planar case)
-  double rotation_rms_rad = 0.0;  ///< rms of phi_a - R phi_b over inliers
-  double translation_rms_m = 0.0; ///< rms of eq 3.3 residuals over inliers
-  std::string message;             ///< why the verdict, for people
+  bool t_z_observable = true;               ///< false under planar motion (eq 3.10 sets t_z = 0)
+  Vec3 planar_axis_a = Vec3::UnitZ();       ///< common rotation axis in {a} (planar case)
+  double rotation_rms_rad = 0.0;            ///< rms of phi_a - R phi_b over inliers
+  double translation_rms_m = 0.0;           ///< rms of eq 3.3 residuals over inliers
+  std::string message;                      ///< why the verdict, for people
 };
 
 /// Eq 3.4 residuals of one pair (independent of X).

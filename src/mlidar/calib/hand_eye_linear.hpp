@@ -15,8 +15,8 @@ Mat4x quaternion_left_matrix(const Quat& q);
 Mat4x quaternion_right_matrix(const Quat& q);
 
 struct QuaternionSystem {
-  Eigen::Matrix4d V;           ///< right singular vectors, columns in descending order
-  Eigen::Vector4d singular;    ///< descending
+  Eigen::Matrix4d V;         ///< right singular vectors, columns in descending order
+  Eigen::Vector4d singular;  ///< descending
 };
 /// Eq 3.5-3.7: SVD of the stacked [left(q_A) - right(q_B)] (4N x 4), both
 /// quaternions taken with w >= 0 so that the blocks agree in sign. `weights`
@@ -32,8 +32,8 @@ Vec3 translation_least_squares(std::span<const MotionPair> pairs, const Quat& R_
 Vec3 common_rotation_axis(std::span<const MotionPair> pairs);
 
 struct PlanarSolution {
-  SE3 T_a_b;                 ///< component of t along the axis set to 0
-  double condition = 0.0;    ///< s_min / s_max of the column-scaled eq 3.12 system
+  SE3 T_a_b;               ///< component of t along the axis set to 0
+  double condition = 0.0;  ///< s_min / s_max of the column-scaled eq 3.12 system
 };
 /// Planar motion (every rotation axis of A along `axis_a`): eq 3.8-3.12 in a
 /// frame a' whose z is axis_a.

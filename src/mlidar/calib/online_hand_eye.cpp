@@ -42,8 +42,8 @@ struct TranslationSystem {
 
 /// Eq 4.18 normal equations, rows (R_A - I) t = R t_B - t_A scaled by w_k like
 /// eq 4.16's, over the pairs whose translation is valid.
-TranslationSystem translation_system(std::span<const MotionPair> pairs, std::span<const double> weights,
-                                     const std::vector<bool>& valid, const Quat& R_base_lidar) {
+TranslationSystem translation_system(std::span<const MotionPair> pairs, std::span<const double> weights, const std::vector<bool>& valid,
+                                     const Quat& R_base_lidar) {
   TranslationSystem s;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (!valid[k]) continue;
@@ -58,8 +58,8 @@ TranslationSystem translation_system(std::span<const MotionPair> pairs, std::spa
 
 /// Eq 4.18's predicted standard deviation of t over the eigen-directions
 /// `first`..2 of `eig`: residual variance (weighted, per solved dimension) / lambda_min.
-double translation_std(std::span<const MotionPair> pairs, std::span<const double> weights, const std::vector<bool>& valid,
-                       const SE3& X, const Eigen::SelfAdjointEigenSolver<Mat3>& eig, int first) {
+double translation_std(std::span<const MotionPair> pairs, std::span<const double> weights, const std::vector<bool>& valid, const SE3& X,
+                       const Eigen::SelfAdjointEigenSolver<Mat3>& eig, int first) {
   double rss = 0.0;
   double rows = 0.0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
@@ -86,9 +86,12 @@ Vec3 signed_common_axis(std::span<const MotionPair> pairs) {
 
 std::string_view to_string(OnlineHandEyeState state) {
   switch (state) {
-    case OnlineHandEyeState::collecting: return "collecting";
-    case OnlineHandEyeState::rotation_ready: return "rotation_ready";
-    case OnlineHandEyeState::ready: return "ready";
+    case OnlineHandEyeState::collecting:
+      return "collecting";
+    case OnlineHandEyeState::rotation_ready:
+      return "rotation_ready";
+    case OnlineHandEyeState::ready:
+      return "ready";
   }
   return "unknown";
 }
@@ -179,7 +182,8 @@ void OnlineHandEye::solve_translation(std::span<const double> weights, const Qua
     // Planar only when every stored pair's rotation says so; a weak direction
     // of the translation-valid subset alone (few pairs, close axes) waits for more pairs.
     const std::vector<bool> all(pairs_.size(), true);
-    const Vec3 all_lambda = Eigen::SelfAdjointEigenSolver<Mat3>(translation_system(pairs_, weights, all, R_base_lidar).normal).eigenvalues();
+    const Vec3 all_lambda =
+        Eigen::SelfAdjointEigenSolver<Mat3>(translation_system(pairs_, weights, all, R_base_lidar).normal).eigenvalues();
     if (!(all_lambda(0) < config_.planar_ratio * all_lambda(2))) return;
   }
   for (int i = first_observable; i < 3; ++i) {

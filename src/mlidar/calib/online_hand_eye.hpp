@@ -59,25 +59,25 @@ std::string_view to_string(OnlineHandEyeState state);
 
 /// What add() did with a pair.
 enum class PairOutcome {
-  stored,            ///< appended (store not full)
-  replaced_smallest, ///< store full: the stored pair with the smallest rotation was dropped for it
-  dropped_small,     ///< store full and the new pair rotates least: the new pair was dropped
-  rejected_invalid,  ///< a non-finite rotation or translation
+  stored,             ///< appended (store not full)
+  replaced_smallest,  ///< store full: the stored pair with the smallest rotation was dropped for it
+  dropped_small,      ///< store full and the new pair rotates least: the new pair was dropped
+  rejected_invalid,   ///< a non-finite rotation or translation
 };
 
 struct OnlineHandEyeStatus {
   OnlineHandEyeState state = OnlineHandEyeState::collecting;
   std::array<double, 4> singular_values{};  ///< of the weighted Q_K (eq 4.16), descending; [2] is sigma_min2
   std::size_t pairs_stored = 0;
-  std::size_t pairs_seen = 0;               ///< every add() call, kept or not
-  SE3 T_base_lidar;                ///< rotation valid from rotation_ready, translation when ready
-  bool planar_motion = false;      ///< translation along unobservable_axis_base fixed to 0
-  Vec3 unobservable_axis_base = Vec3::Zero();  ///< unit, set when planar_motion
+  std::size_t pairs_seen = 0;                       ///< every add() call, kept or not
+  SE3 T_base_lidar;                                 ///< rotation valid from rotation_ready, translation when ready
+  bool planar_motion = false;                       ///< translation along unobservable_axis_base fixed to 0
+  Vec3 unobservable_axis_base = Vec3::Zero();       ///< unit, set when planar_motion
   std::array<double, 3> translation_eigenvalues{};  ///< of eq 4.18's normal matrix, ascending
-  double rotation_rms_rad = 0.0;   ///< rms residual angle (eq 4.17's phi) over the stored pairs
-  std::size_t pairs_translation = 0;  ///< stored pairs whose translation is used (eq 4.18)
-  double translation_std_m = -1.0;    ///< eq 4.18's predicted standard deviation (-1: not solved)
-  bool planar_rotation = false;       ///< rotation about unobservable_axis_base from the translations (eq 3.10-3.12)
+  double rotation_rms_rad = 0.0;                    ///< rms residual angle (eq 4.17's phi) over the stored pairs
+  std::size_t pairs_translation = 0;                ///< stored pairs whose translation is used (eq 4.18)
+  double translation_std_m = -1.0;                  ///< eq 4.18's predicted standard deviation (-1: not solved)
+  bool planar_rotation = false;                     ///< rotation about unobservable_axis_base from the translations (eq 3.10-3.12)
 };
 
 class OnlineHandEye {

@@ -6,9 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
-
 #include "mlidar/core/conversions.hpp"
+#include "mlidar/core/covariance.hpp"
 
 namespace mlidar::calib {
 namespace {
@@ -59,18 +58,13 @@ Mat6 systematic_covariance(const PairRefineConfig& config) {
   return diagonal.asDiagonal();
 }
 
-double largest_sd(const Mat3& block) {
-  return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat3>(block).eigenvalues()(2)));
-}
-
 /// The checks a result must pass (empty: trusted).
 std::vector<std::string> failed_checks(const Candidate& c, const PairRefineConfig& config) {
   std::vector<std::string> reasons;
   const IcpResult& icp = c.icp;
   if (!icp.enough_matches) reasons.push_back("too few matches (" + std::to_string(icp.matches) + ")");
   if (!icp.converged) reasons.push_back("ICP did not settle within " + std::to_string(config.icp.max_iterations) + " iterations");
-  if (c.fitness < config.min_overlap)
-    reasons.push_back("overlap " + fixed(c.fitness, 2) + " < " + fixed(config.min_overlap, 2));
+  if (c.fitness < config.min_overlap) reasons.push_back("overlap " + fixed(c.fitness, 2) + " < " + fixed(config.min_overlap, 2));
   if (icp.rmse > config.max_rmse) reasons.push_back("rmse " + fixed(icp.rmse, 3) + " m > " + fixed(config.max_rmse, 3) + " m");
   if (icp.covariance.isZero()) {
     reasons.push_back("information matrix singular (degenerate geometry)");
@@ -100,8 +94,8 @@ std::vector<std::string> ambiguity(const Candidate& best, std::span<const Candid
     const double rot = rotation_deg_between(best.icp.T_ref_source, other.icp.T_ref_source);
     const double trans = (best.icp.T_ref_source.translation() - other.icp.T_ref_source.translation()).norm();
     if (distinct(best.icp.T_ref_source, other.icp.T_ref_source, config) && other.fitness >= best.fitness - config.ambiguity_margin)
-      reasons.push_back("ambiguous: start '" + other.label + "' reaches overlap " + fixed(other.fitness, 2) + " at " +
-                        fixed(rot, 1) + " deg / " + fixed(trans, 2) + " m from the answer");
+      reasons.push_back("ambiguous: start '" + other.label + "' reaches overlap " + fixed(other.fitness, 2) + " at " + fixed(rot, 1) +
+                        " deg / " + fixed(trans, 2) + " m from the answer");
   }
   return reasons;
 }
@@ -115,7 +109,8 @@ std::vector<Eigen::Vector3f> beyond(std::span<const Eigen::Vector3f> points, dou
 }
 
 void check_config(const PairRefineConfig& config) {
-  if (!(config.min_range >= 0.0) || !(config.ref_voxel_size > 0.0) || !(config.search_ref_voxel_size > 0.0) || !(config.overlap_radius > 0.0) || !(config.fitness_voxel_size > 0.0))
+  if (!(config.min_range >= 0.0) || !(config.ref_voxel_size > 0.0) || !(config.search_ref_voxel_size > 0.0) ||
+      !(config.overlap_radius > 0.0) || !(config.fitness_voxel_size > 0.0))
     throw std::invalid_argument("refine_pair: voxel sizes and overlap_radius must be > 0");
   if (!(config.systematic_rotation_sd_deg >= 0.0) || !(config.systematic_translation_sd_m >= 0.0))
     throw std::invalid_argument("refine_pair: systematic sd must be >= 0");
@@ -123,9 +118,9 @@ void check_config(const PairRefineConfig& config) {
 }
 
 /// The multi-start stage: short ICP from every start, the best few refined fully.
-std::vector<Candidate> search(RefSurface& surface, std::span<const Eigen::Vector3f> ref,
-                              std::span<const Eigen::Vector3f> target, std::span<const Eigen::Vector3f> fitness_target,
-                              const SE3& T_init, const PairRefineConfig& config, PairRefineResult& result) {
+std::vector<Candidate> search(RefSurface& surface, std::span<const Eigen::Vector3f> ref, std::span<const Eigen::Vector3f> target,
+                              std::span<const Eigen::Vector3f> fitness_target, const SE3& T_init, const PairRefineConfig& config,
+                              PairRefineResult& result) {
   RefSurface coarse(voxel_downsample(ref, config.search_ref_voxel_size), config.surface);
   std::vector<Candidate> shorts;
   for (const StartPose& start : coarse_starts(ref, target, T_init, config.search)) {
@@ -139,8 +134,8 @@ std::vector<Candidate> search(RefSurface& surface, std::span<const Eigen::Vector
   std::vector<SE3> refined_from;
   for (const Candidate& s : shorts) {
     if (finalists.size() == config.search_finalists) break;
-    const bool seen = std::any_of(refined_from.begin(), refined_from.end(),
-                                  [&](const SE3& T) { return !distinct(T, s.icp.T_ref_source, config); });
+    const bool seen =
+        std::any_of(refined_from.begin(), refined_from.end(), [&](const SE3& T) { return !distinct(T, s.icp.T_ref_source, config); });
     if (seen) continue;  // the same basin as a better start
     refined_from.push_back(s.icp.T_ref_source);
     Candidate c{point_to_plane_icp(surface, target, s.icp.T_ref_source, config.icp), 0.0, s.label};
@@ -153,8 +148,8 @@ std::vector<Candidate> search(RefSurface& surface, std::span<const Eigen::Vector
 /// Midpoint of T_forward and the inverse of the reverse registration on SO(3) x R^3
 /// (half the geodesic from one rotation to the other; mean translation), or nullopt
 /// when the reverse registration did not settle or is a distinct pose.
-std::optional<SE3> symmetric_answer(std::span<const Eigen::Vector3f> ref, std::span<const Eigen::Vector3f> target,
-                                    const SE3& T_forward, const PairRefineConfig& config) {
+std::optional<SE3> symmetric_answer(std::span<const Eigen::Vector3f> ref, std::span<const Eigen::Vector3f> target, const SE3& T_forward,
+                                    const PairRefineConfig& config) {
   RefSurface target_surface(std::vector<Eigen::Vector3f>(target.begin(), target.end()), config.surface);
   const IcpResult back = point_to_plane_icp(target_surface, ref, T_forward.inverse(), config.icp);
   const SE3 T_backward = back.T_ref_source.inverse();
@@ -167,15 +162,18 @@ std::optional<SE3> symmetric_answer(std::span<const Eigen::Vector3f> ref, std::s
 
 std::string_view to_string(PairVerdict verdict) {
   switch (verdict) {
-    case PairVerdict::kConverged: return "converged";
-    case PairVerdict::kSearchedAndConverged: return "searched_and_converged";
-    case PairVerdict::kNotConverged: return "not_converged";
+    case PairVerdict::kConverged:
+      return "converged";
+    case PairVerdict::kSearchedAndConverged:
+      return "searched_and_converged";
+    case PairVerdict::kNotConverged:
+      return "not_converged";
   }
   return "not_converged";
 }
 
-PairRefineResult refine_pair(std::span<const Eigen::Vector3f> ref, std::span<const Eigen::Vector3f> target,
-                             const SE3& T_init, const PairRefineConfig& config) {
+PairRefineResult refine_pair(std::span<const Eigen::Vector3f> ref, std::span<const Eigen::Vector3f> target, const SE3& T_init,
+                             const PairRefineConfig& config) {
   check_config(config);
   PairRefineResult result;
   result.T_init = T_init;
@@ -199,8 +197,7 @@ PairRefineResult refine_pair(std::span<const Eigen::Vector3f> ref, std::span<con
   const bool poor = !failed_checks(from_init, config).empty();
   result.searched = config.search_mode == PairSearchMode::kAlways || (config.search_mode == PairSearchMode::kAuto && poor);
   if (result.searched) {
-    for (Candidate& c : search(surface, ref_thin, target_thin, fitness_target, T_init, config, result))
-      candidates.push_back(std::move(c));
+    for (Candidate& c : search(surface, ref_thin, target_thin, fitness_target, T_init, config, result)) candidates.push_back(std::move(c));
   }
   std::stable_sort(candidates.begin(), candidates.end(), better);
   const Candidate& best = candidates.front();
@@ -225,8 +222,7 @@ PairRefineResult refine_pair(std::span<const Eigen::Vector3f> ref, std::span<con
   result.overlap = overlap(surface.tree(), target_thin, result.T_ref_target, config.overlap_radius);
   result.reasons = failed_checks(best, config);
   for (std::string& reason : ambiguity(best, std::span(candidates).subspan(1), config)) result.reasons.push_back(std::move(reason));
-  if (result.reasons.empty())
-    result.verdict = best.label == "init" ? PairVerdict::kConverged : PairVerdict::kSearchedAndConverged;
+  if (result.reasons.empty()) result.verdict = best.label == "init" ? PairVerdict::kConverged : PairVerdict::kSearchedAndConverged;
   return result;
 }
 

@@ -4,9 +4,8 @@
 #include <cmath>
 #include <numbers>
 
-#include <Eigen/Eigenvalues>
-
 #include "mlidar/calib/planes_refine.hpp"
+#include "mlidar/core/covariance.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/geometry/kabsch.hpp"
 
@@ -18,8 +17,7 @@ constexpr std::size_t kMinPlanePoints = 6;
 constexpr int kReassignRounds = 10;
 
 /// At most `limit` points of plane `indices`, evenly strided (deterministic).
-std::vector<Vec3> subsample(std::span<const Eigen::Vector3f> points, const std::vector<std::uint32_t>& indices,
-                            std::size_t limit) {
+std::vector<Vec3> subsample(std::span<const Eigen::Vector3f> points, const std::vector<std::uint32_t>& indices, std::size_t limit) {
   const std::size_t count = std::min(limit, indices.size());
   std::vector<Vec3> out;
   out.reserve(count);
@@ -38,8 +36,7 @@ CloudCornerReport report_of(const Corner& corner, std::size_t planes_found) {
 
 Plane plane_in_target(const Plane& plane_ref, const SE3& T_ref_target) {
   // n.(R q + t) + d = (R^T n).q + (n.t + d)
-  return {T_ref_target.rotation().conjugate() * plane_ref.normal,
-          plane_ref.normal.dot(T_ref_target.translation()) + plane_ref.offset};
+  return {T_ref_target.rotation().conjugate() * plane_ref.normal, plane_ref.normal.dot(T_ref_target.translation()) + plane_ref.offset};
 }
 
 void add_warnings(const PlanesConfig& config, const Corner& ref, const Corner& target, PlanesResult& result) {
@@ -66,8 +63,8 @@ SE3 closed_form_T_ref_target(const std::array<Plane, 3>& ref_planes, const std::
     target_normals[i] = target_planes[i].normal;
     ref_normals[i] = ref_planes[i].normal;
   }
-  const Mat3 R = kabsch_rotation(target_normals, ref_normals);                      // eq 2.6
-  const Vec3 t = corner_point(ref_planes) - R * corner_point(target_planes);        // eq 2.7 (with R)
+  const Mat3 R = kabsch_rotation(target_normals, ref_normals);                // eq 2.6
+  const Vec3 t = corner_point(ref_planes) - R * corner_point(target_planes);  // eq 2.7 (with R)
   return SE3(Quat(R).normalized(), t);
 }
 
@@ -91,12 +88,11 @@ void align_order_to_guess(Corner& target, const Corner& ref, const Quat& R_ref_t
 
 PlanesCalibrator::PlanesCalibrator(PlanesConfig config) : config_(std::move(config)) { config_.validate(); }
 
-Corner PlanesCalibrator::corner_of(std::span<const Eigen::Vector3f> points, const std::string& source,
-                                   std::size_t& planes_found) const {
+Corner PlanesCalibrator::corner_of(std::span<const Eigen::Vector3f> points, const std::string& source, std::size_t& planes_found) const {
   if (points.size() < 3 * config_.min_plane_points)
-    throw InputError(source, "points",
-                     "has " + std::to_string(points.size()) + " points; three planes need at least " +
-                         std::to_string(3 * config_.min_plane_points));
+    throw InputError(
+        source, "points",
+        "has " + std::to_string(points.size()) + " points; three planes need at least " + std::to_string(3 * config_.min_plane_points));
   PlaneRansacConfig ransac;
   ransac.inlier_distance = config_.inlier_distance;
   ransac.max_iterations = config_.ransac_iterations;
@@ -105,15 +101,14 @@ Corner PlanesCalibrator::corner_of(std::span<const Eigen::Vector3f> points, cons
   ransac.seed = config_.seed;
   const std::vector<PlaneSegment> segments = extract_planes(points, ransac);  // eq 2.1-2.2
   planes_found = segments.size();
-  Corner corner = find_corner(points, segments, config_, source);             // eq 2.3-2.5
+  Corner corner = find_corner(points, segments, config_, source);  // eq 2.3-2.5
   for (const auto& inliers : corner.inliers) {
     if (inliers.size() < kMinPlanePoints) throw InputError(source, "planes", "a corner plane keeps fewer than 6 points");
   }
   return corner;
 }
 
-PlanesResult PlanesCalibrator::calibrate(std::span<const Eigen::Vector3f> ref_points,
-                                         std::span<const Eigen::Vector3f> target_points,
+PlanesResult PlanesCalibrator::calibrate(std::span<const Eigen::Vector3f> ref_points, std::span<const Eigen::Vector3f> target_points,
                                          const std::optional<SE3>& T_ref_target_guess, const std::string& ref_source,
                                          const std::string& target_source) const {
   std::size_t ref_found = 0;
@@ -158,8 +153,7 @@ PlanesResult PlanesCalibrator::calibrate(std::span<const Eigen::Vector3f> ref_po
   result.residual_sigma = refined.residual_sigma;
   result.iterations = refined.iterations;
   result.converged = refined.converged;
-  const Eigen::SelfAdjointEigenSolver<Mat3> rotation_cov(result.covariance.bottomRightCorner<3, 3>());
-  result.rotation_sigma_max_deg = std::sqrt(std::max(0.0, rotation_cov.eigenvalues()(2))) / kDeg;
+  result.rotation_sigma_max_deg = largest_sd(result.covariance.bottomRightCorner<3, 3>()) / kDeg;
   result.ref = report_of(ref, ref_found);
   result.target = report_of(target, target_found);
   for (int i = 0; i < 3; ++i) {

@@ -67,7 +67,7 @@ Linearization linearize(const RefineProblem& problem, const State& state, double
       accumulate(lin, jacobian, plane.signed_distance(p), delta);
     }
     const Vec3 rotated_normal = R.transpose() * plane.normal;
-    jacobian.head<3>() = plane.normal;  // dr/d(dt)
+    jacobian.head<3>() = plane.normal;                // dr/d(dt)
     for (const Vec3& q : problem.target_points[i]) {  // r = n.(R q + t) + d
       const Vec3 x = R * q + t;
       jacobian.segment<3>(3) = q.cross(rotated_normal);  // dr/d(dr) = -n^T R [q]x

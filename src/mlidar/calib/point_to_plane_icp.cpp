@@ -19,8 +19,7 @@ struct LinearSystem {
   std::size_t matches = 0;
 };
 
-LinearSystem build_system(RefSurface& surface, std::span<const Eigen::Vector3f> source, const SE3& T,
-                          const IcpLevel& level) {
+LinearSystem build_system(RefSurface& surface, std::span<const Eigen::Vector3f> source, const SE3& T, const IcpLevel& level) {
   LinearSystem system;
   const Mat3 R = T.rotation_matrix();
   const double max_sq = level.max_correspondence * level.max_correspondence;
@@ -49,10 +48,9 @@ LinearSystem build_system(RefSurface& surface, std::span<const Eigen::Vector3f> 
 }
 
 /// The source thinned for one level: voxel filter, then an even stride down to max_points.
-std::vector<Eigen::Vector3f> level_points(std::span<const Eigen::Vector3f> source, const IcpLevel& level,
-                                          std::size_t max_points) {
-  std::vector<Eigen::Vector3f> thinned = level.voxel_size > 0.0 ? voxel_downsample(source, level.voxel_size)
-                                                                : std::vector<Eigen::Vector3f>(source.begin(), source.end());
+std::vector<Eigen::Vector3f> level_points(std::span<const Eigen::Vector3f> source, const IcpLevel& level, std::size_t max_points) {
+  std::vector<Eigen::Vector3f> thinned =
+      level.voxel_size > 0.0 ? voxel_downsample(source, level.voxel_size) : std::vector<Eigen::Vector3f>(source.begin(), source.end());
   if (thinned.size() <= max_points) return thinned;
   std::vector<Eigen::Vector3f> strided;
   strided.reserve(max_points);

@@ -19,29 +19,29 @@
 namespace mlidar::calib {
 
 struct IcpLevel {
-  double voxel_size = 0.5;               ///< m, source downsampling (0 = keep every point)
-  double max_correspondence = 1.0;       ///< m, farther nearest neighbours are not matched
-  double kernel_scale = 0.2;             ///< m, c of the Cauchy kernel; |r| <= 3c is an inlier
+  double voxel_size = 0.5;          ///< m, source downsampling (0 = keep every point)
+  double max_correspondence = 1.0;  ///< m, farther nearest neighbours are not matched
+  double kernel_scale = 0.2;        ///< m, c of the Cauchy kernel; |r| <= 3c is an inlier
 };
 
 struct IcpConfig {
   std::vector<IcpLevel> levels{{1.0, 2.0, 0.5}, {0.4, 0.8, 0.15}, {0.1, 0.2, 0.03}};
-  int max_iterations = 30;               ///< per level
-  std::size_t max_points = 20000;        ///< per level, more thinned source points are strided down to this
-  double rotation_tolerance = 2e-4;      ///< rad: a smaller step ends the level
-  double translation_tolerance = 1e-3;   ///< m
-  std::size_t min_matches = 30;          ///< fewer matches: the registration fails
+  int max_iterations = 30;              ///< per level
+  std::size_t max_points = 20000;       ///< per level, more thinned source points are strided down to this
+  double rotation_tolerance = 2e-4;     ///< rad: a smaller step ends the level
+  double translation_tolerance = 1e-3;  ///< m
+  std::size_t min_matches = 30;         ///< fewer matches: the registration fails
 };
 
 struct IcpResult {
   SE3 T_ref_source;
-  Mat6 information = Mat6::Zero();       ///< J^T W J at the solution, [t, r] order
-  Mat6 covariance = Mat6::Zero();        ///< s^2 H^-1 (zero when H is singular)
-  double rmse = 0.0;                     ///< m, of the inliers' point-to-plane residuals (last level)
-  double inlier_ratio = 0.0;             ///< inliers / thinned source points (last level)
-  std::size_t matches = 0;               ///< correspondences within max_correspondence (last level)
-  int iterations = 0;                    ///< over all levels
-  bool converged = false;                ///< the last level's step fell below the tolerances
+  Mat6 information = Mat6::Zero();  ///< J^T W J at the solution, [t, r] order
+  Mat6 covariance = Mat6::Zero();   ///< s^2 H^-1 (zero when H is singular)
+  double rmse = 0.0;                ///< m, of the inliers' point-to-plane residuals (last level)
+  double inlier_ratio = 0.0;        ///< inliers / thinned source points (last level)
+  std::size_t matches = 0;          ///< correspondences within max_correspondence (last level)
+  int iterations = 0;               ///< over all levels
+  bool converged = false;           ///< the last level's step fell below the tolerances
   bool enough_matches = true;
 };
 

@@ -21,10 +21,10 @@ namespace mlidar::calib {
 std::vector<Eigen::Vector3f> voxel_downsample(std::span<const Eigen::Vector3f> points, double voxel_size);
 
 struct SurfaceConfig {
-  std::size_t normal_neighbours = 20;  ///< k of the PCA
-  double max_neighbour_distance = 1.5; ///< m; a farther k-th neighbour makes the normal invalid
-  double max_planarity = 0.1;          ///< lambda_min / lambda_mid above this: not a plane
-  double min_line_ratio = 0.05;        ///< lambda_mid / lambda_max below this: points on a line (one ring)
+  std::size_t normal_neighbours = 20;   ///< k of the PCA
+  double max_neighbour_distance = 1.5;  ///< m; a farther k-th neighbour makes the normal invalid
+  double max_planarity = 0.1;           ///< lambda_min / lambda_mid above this: not a plane
+  double min_line_ratio = 0.05;         ///< lambda_mid / lambda_max below this: points on a line (one ring)
 };
 
 /// A reference cloud ready for point-to-plane queries. Owns its tree; the
@@ -49,8 +49,8 @@ class RefSurface {
 /// points of b with a point of a within `radius` after mapping b into a, S^a
 /// the points of a with a mapped point of b within `radius`.
 struct Overlap {
-  double fraction_b = 0.0;  ///< |S^b| / |P^b|
-  double fraction_a = 0.0;  ///< |S^a| / |P^a|
+  double fraction_b = 0.0;                                  ///< |S^b| / |P^b|
+  double fraction_a = 0.0;                                  ///< |S^a| / |P^a|
   double omega() const { return fraction_a * fraction_b; }  ///< eq 3.14
 };
 /// tree_a indexes P^a; points_b is P^b in its own frame.

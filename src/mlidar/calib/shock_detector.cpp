@@ -4,30 +4,23 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "mlidar/core/median.hpp"
+
 namespace mlidar::calib {
 namespace {
 
 constexpr double kMadToSigma = 1.4826;  ///< MAD of a Gaussian times this is its sigma
 constexpr double kTinyResidual = 1e-12;
 
-double median(std::vector<double> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  if (values.size() % 2 == 1) return *middle;
-  return 0.5 * (*middle + *std::max_element(values.begin(), middle));
-}
-
 bool valid(double residual) { return std::isfinite(residual) && residual > kTinyResidual; }
 
 }  // namespace
 
-ShockDetector::ShockDetector(std::size_t lidar_count, ShockDetectorConfig config)
-    : config_(config), lidars_(lidar_count) {
-  const bool ok = lidar_count > 0 && config_.min_history >= 3 && config_.history >= config_.min_history &&
-                  config_.threshold_mads > 0.0 && config_.min_relative_jump > 0.0 && config_.consecutive >= 1;
+ShockDetector::ShockDetector(std::size_t lidar_count, ShockDetectorConfig config) : config_(config), lidars_(lidar_count) {
+  const bool ok = lidar_count > 0 && config_.min_history >= 3 && config_.history >= config_.min_history && config_.threshold_mads > 0.0 &&
+                  config_.min_relative_jump > 0.0 && config_.consecutive >= 1;
   if (!ok) {
-    throw std::invalid_argument(
-        "ShockDetector: needs >= 1 LiDAR, 3 <= min_history <= history, thresholds > 0, consecutive >= 1");
+    throw std::invalid_argument("ShockDetector: needs >= 1 LiDAR, 3 <= min_history <= history, thresholds > 0, consecutive >= 1");
   }
 }
 

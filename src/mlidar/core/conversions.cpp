@@ -29,10 +29,7 @@ Vec4 quat_to_wxyz(const Quat& q) {
 }
 
 Quat quat_from_rpy(const Vec3& rpy) {
-  return (Quat(Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ())) *
-          Quat(Eigen::AngleAxisd(rpy.y(), Vec3::UnitY())) *
-          Quat(Eigen::AngleAxisd(rpy.x(), Vec3::UnitX())))
-      .normalized();
+  return Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) * Eigen::AngleAxisd(rpy.x(), Vec3::UnitX());
 }
 
 // With R = Rz(y) Ry(p) Rx(r): R(2,0) = -sin p, R(0,0) = cos p cos y, R(1,0) = cos p sin y.
@@ -44,8 +41,8 @@ Vec3 rpy_from_quat(const Quat& q) {
   const double yaw = cos_pitch < kGimbalLockCos ? std::atan2(-r(0, 1), r(1, 1)) : std::atan2(r(1, 0), r(0, 0));
   // Roll from the residual Rx(roll) = Ry(p)^T Rz(y)^T R absorbs any yaw error
   // (near the lock a yaw error is almost a rotation about x).
-  const Mat3 residual = Eigen::AngleAxisd(-pitch, Vec3::UnitY()).toRotationMatrix() *
-                        Eigen::AngleAxisd(-yaw, Vec3::UnitZ()).toRotationMatrix() * r;
+  const Mat3 residual =
+      Eigen::AngleAxisd(-pitch, Vec3::UnitY()).toRotationMatrix() * Eigen::AngleAxisd(-yaw, Vec3::UnitZ()).toRotationMatrix() * r;
   const double roll = std::atan2(residual(2, 1), residual(2, 2));
   return {roll, pitch, yaw};
 }

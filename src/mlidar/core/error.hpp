@@ -9,10 +9,10 @@ namespace mlidar {
 
 /// Process exit codes of the mlidar CLI (public interface; never renumber).
 enum class ExitCode : int {
-  kOk = 0,          ///< the job ran and its result can be trusted
-  kUntrusted = 1,   ///< the job ran but failed or its result should not be trusted
-  kUsage = 2,       ///< bad command line or configuration, or an output that cannot be written
-  kBadInput = 3,    ///< unreadable or invalid input data
+  kOk = 0,         ///< the job ran and its result can be trusted
+  kUntrusted = 1,  ///< the job ran but failed or its result should not be trusted
+  kUsage = 2,      ///< bad command line or configuration, or an output that cannot be written
+  kBadInput = 3,   ///< unreadable or invalid input data
 };
 
 /// Invalid or unreadable input. what() reads "FILE: FIELD: problem (fix)".

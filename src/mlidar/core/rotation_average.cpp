@@ -14,14 +14,13 @@ void check_weights(std::span<const Quat> rotations, std::span<const double> weig
   if (rotations.empty()) throw std::invalid_argument("rotation mean: no rotations given (expected at least one)");
   if (weights.empty()) return;
   if (weights.size() != rotations.size()) {
-    throw std::invalid_argument("rotation mean: " + std::to_string(weights.size()) + " weights for " +
-                                std::to_string(rotations.size()) + " rotations (expected one each)");
+    throw std::invalid_argument("rotation mean: " + std::to_string(weights.size()) + " weights for " + std::to_string(rotations.size()) +
+                                " rotations (expected one each)");
   }
   double total = 0.0;
   for (const double w : weights) {
     if (!std::isfinite(w) || w < 0.0) {
-      throw std::invalid_argument("rotation mean: weight " + std::to_string(w) +
-                                  " (expected a finite value >= 0)");
+      throw std::invalid_argument("rotation mean: weight " + std::to_string(w) + " (expected a finite value >= 0)");
     }
     total += w;
   }

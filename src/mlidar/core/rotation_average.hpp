@@ -15,15 +15,15 @@ Quat chordal_mean(std::span<const Quat> rotations, std::span<const double> weigh
 
 struct RobustMeanOptions {
   int max_iterations = 100;
-  double step_tolerance = 1e-12;   ///< stop when an update rotates by less (rad)
-  double min_distance = 1e-12;     ///< floor on d_i in the weights 1/d_i (rad)
+  double step_tolerance = 1e-12;  ///< stop when an update rotates by less (rad)
+  double min_distance = 1e-12;    ///< floor on d_i in the weights 1/d_i (rad)
 };
 
 struct RobustMeanResult {
   Quat mean = Quat::Identity();
   int iterations = 0;
-  bool converged = false;        ///< step fell below step_tolerance
-  double cost = 0.0;             ///< sum_i d(mean, R_i), geodesic L1 (rad)
+  bool converged = false;  ///< step fell below step_tolerance
+  double cost = 0.0;       ///< sum_i d(mean, R_i), geodesic L1 (rad)
 };
 
 /// Geodesic L1 mean (the median on SO(3)) by the Weiszfeld iteration of
@@ -32,7 +32,6 @@ struct RobustMeanResult {
 ///   v_i = Log(R^-1 R_i),  R <- R Exp(sum_i v_i / d_i / sum_i 1 / d_i).
 /// Outliers pull with unit force whatever their distance, so a minority of
 /// gross outliers barely moves the result. Throws like chordal_mean on empty input.
-RobustMeanResult robust_rotation_mean(std::span<const Quat> rotations,
-                                      const RobustMeanOptions& options = {});
+RobustMeanResult robust_rotation_mean(std::span<const Quat> rotations, const RobustMeanOptions& options = {});
 
 }  // namespace mlidar

@@ -12,9 +12,7 @@ namespace mlidar {
 namespace {
 constexpr double kSeriesAngle = 1e-2;  // see so3.cpp
 
-[[noreturn]] void reject_matrix(const std::string& problem) {
-  throw InputError("", "4x4 matrix", problem);
-}
+[[noreturn]] void reject_matrix(const std::string& problem) { throw InputError("", "4x4 matrix", problem); }
 
 // Barfoot eq 7.86b: the coupling block Q(rho, phi) of the SE(3) left Jacobian.
 Mat3 q_block(const Vec3& rho, const Vec3& phi) {
@@ -43,13 +41,11 @@ Mat3 q_block(const Vec3& rho, const Vec3& phi) {
   const Mat3 pr = p * r;
   const Mat3 rp = r * p;
   const Mat3 prp = pr * p;
-  return 0.5 * r + c1 * (pr + rp + prp) + c2 * (p * pr + rp * p - 3.0 * prp) +
-         c3 * (prp * p + p * prp);
+  return 0.5 * r + c1 * (pr + rp + prp) + c2 * (p * pr + rp * p - 3.0 * prp) + c3 * (prp * p + p * prp);
 }
 }  // namespace
 
-SE3::SE3(const Quat& rotation, const Vec3& translation)
-    : rotation_(rotation.normalized()), translation_(translation) {}
+SE3::SE3(const Quat& rotation, const Vec3& translation) : rotation_(rotation.normalized()), translation_(translation) {}
 
 SE3 SE3::from_matrix(const Mat4& matrix, double orthonormal_tolerance) {
   if (!matrix.allFinite()) reject_matrix("has a NaN or infinite entry (expected finite numbers)");
@@ -82,9 +78,7 @@ SE3 SE3::inverse() const {
   return {r_inv, -(r_inv * translation_)};
 }
 
-SE3 SE3::operator*(const SE3& other) const {
-  return {rotation_ * other.rotation_, rotation_ * other.translation_ + translation_};
-}
+SE3 SE3::operator*(const SE3& other) const { return {rotation_ * other.rotation_, rotation_ * other.translation_ + translation_}; }
 
 SE3 SE3::exp(const Vec6& xi) {
   const Vec3 rho = xi.head<3>();
@@ -109,9 +103,7 @@ Mat6 SE3::adjoint() const {
   return ad;
 }
 
-SE3 interpolate(const SE3& a, const SE3& b, double s) {
-  return a * SE3::exp(s * (a.inverse() * b).log());
-}
+SE3 interpolate(const SE3& a, const SE3& b, double s) { return a * SE3::exp(s * (a.inverse() * b).log()); }
 
 void transform_points(const SE3& T, std::span<const Eigen::Vector3f> points, std::span<Eigen::Vector3f> out) {
   if (points.size() != out.size()) {

@@ -29,8 +29,7 @@ class SE3 {
   /// Rejects (throws InputError, field "4x4 matrix"): a non-finite entry, a
   ///   bottom row other than [0 0 0 1], ||R^T R - I||_F above the tolerance
   ///   (scale or shear), or det(R) < 0 (a reflection).
-  static SE3 from_matrix(const Mat4& matrix,
-                         double orthonormal_tolerance = kDefaultOrthonormalTolerance);
+  static SE3 from_matrix(const Mat4& matrix, double orthonormal_tolerance = kDefaultOrthonormalTolerance);
 
   const Quat& rotation() const { return rotation_; }
   Mat3 rotation_matrix() const { return rotation_.toRotationMatrix(); }
@@ -40,9 +39,7 @@ class SE3 {
   SE3 inverse() const;
   SE3 operator*(const SE3& other) const;
   Vec3 operator*(const Vec3& point) const { return rotation_ * point + translation_; }
-  Eigen::Vector3f operator*(const Eigen::Vector3f& point) const {
-    return (rotation_ * point.cast<double>() + translation_).cast<float>();
-  }
+  Eigen::Vector3f operator*(const Eigen::Vector3f& point) const { return (rotation_ * point.cast<double>() + translation_).cast<float>(); }
 
   /// Exp of [rho, phi]: (Exp(phi), J_l(phi) rho).
   static SE3 exp(const Vec6& xi);

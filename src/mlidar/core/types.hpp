@@ -13,11 +13,11 @@ namespace mlidar {
 /// One sweep of one LiDAR. Geometry is contiguous xyz (float) so hot loops
 /// stream memory; optional channels are parallel arrays, empty when absent.
 struct Scan {
-  double stamp = 0.0;                     ///< sweep start, seconds
-  std::vector<Eigen::Vector3f> points;    ///< in the LiDAR frame, metres
-  std::vector<float> intensity;           ///< empty or points.size()
-  std::vector<std::uint16_t> ring;        ///< empty or points.size()
-  std::vector<float> time;                ///< seconds from stamp; empty or points.size()
+  double stamp = 0.0;                   ///< sweep start, seconds
+  std::vector<Eigen::Vector3f> points;  ///< in the LiDAR frame, metres
+  std::vector<float> intensity;         ///< empty or points.size()
+  std::vector<std::uint16_t> ring;      ///< empty or points.size()
+  std::vector<float> time;              ///< seconds from stamp; empty or points.size()
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
@@ -30,32 +30,15 @@ struct Scan {
 
 /// Intrinsic description of a spinning LiDAR.
 struct LidarModel {
-  std::string name;                       ///< e.g. "VLP-16"
-  std::vector<double> vertical_angles_deg;///< one per ring, ring order
+  std::string name;                         ///< e.g. "VLP-16"
+  std::vector<double> vertical_angles_deg;  ///< one per ring, ring order
   double horizontal_resolution_deg = 0.2;
-  double min_range = 0.5;                 ///< metres
-  double max_range = 100.0;               ///< metres
-  double range_noise_sigma = 0.0;         ///< metres, 1-sigma Gaussian
-  double sweep_period = 0.1;              ///< seconds per revolution
+  double min_range = 0.5;          ///< metres
+  double max_range = 100.0;        ///< metres
+  double range_noise_sigma = 0.0;  ///< metres, 1-sigma Gaussian
+  double sweep_period = 0.1;       ///< seconds per revolution
 
   std::size_t rings() const { return vertical_angles_deg.size(); }
-};
-
-/// One LiDAR mounted on the rig: its model and extrinsic with 6x6 covariance
-/// in [t, r] order (rotation in the local tangent, rad).
-struct MountedLidar {
-  std::string name;
-  LidarModel model;
-  SE3 T_base_lidar;
-  Mat6 covariance = Mat6::Zero();
-};
-
-struct Rig {
-  std::string base_frame = "base";
-  std::vector<MountedLidar> lidars;       ///< lidars[0] is the primary (base) LiDAR
-
-  /// Index of the LiDAR called name, or -1.
-  int find(const std::string& name) const;
 };
 
 /// The scans of all LiDARs at one time step, in rig order.

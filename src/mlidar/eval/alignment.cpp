@@ -8,10 +8,14 @@ namespace mlidar::eval {
 
 const char* align_mode_name(AlignMode mode) {
   switch (mode) {
-    case AlignMode::kNone: return "none";
-    case AlignMode::kOrigin: return "origin";
-    case AlignMode::kSe3: return "se3";
-    case AlignMode::kSim3: return "sim3";
+    case AlignMode::kNone:
+      return "none";
+    case AlignMode::kOrigin:
+      return "origin";
+    case AlignMode::kSe3:
+      return "se3";
+    case AlignMode::kSim3:
+      return "sim3";
   }
   return "none";
 }
@@ -21,11 +25,11 @@ SE3 Alignment::apply(const SE3& T_world_est) const {
              scale * (T_gt_est.rotation() * T_world_est.translation()) + T_gt_est.translation());
 }
 
-Alignment umeyama_alignment(const std::vector<Vec3>& src, const std::vector<Vec3>& dst, bool with_scale,
-                            const std::string& source) {
+Alignment umeyama_alignment(const std::vector<Vec3>& src, const std::vector<Vec3>& dst, bool with_scale, const std::string& source) {
   if (src.size() != dst.size() || src.size() < 3)
-    throw InputError(source, "positions", "at least 3 associated poses are needed to align (got " +
-                                              std::to_string(src.size()) + "); use --align origin or none");
+    throw InputError(
+        source, "positions",
+        "at least 3 associated poses are needed to align (got " + std::to_string(src.size()) + "); use --align origin or none");
   const double n = static_cast<double>(src.size());
   Vec3 mean_src = Vec3::Zero();
   Vec3 mean_dst = Vec3::Zero();
@@ -59,8 +63,7 @@ Alignment umeyama_alignment(const std::vector<Vec3>& src, const std::vector<Vec3
   return alignment;
 }
 
-Alignment compute_alignment(AlignMode mode, const std::vector<SE3>& gt, const std::vector<SE3>& est,
-                            const std::string& source) {
+Alignment compute_alignment(AlignMode mode, const std::vector<SE3>& gt, const std::vector<SE3>& est, const std::string& source) {
   Alignment alignment;
   alignment.mode = mode;
   if (mode == AlignMode::kNone || gt.empty()) return alignment;

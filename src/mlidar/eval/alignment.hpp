@@ -35,11 +35,9 @@ struct Alignment {
 /// sum_i |dst_i - (s R src_i + t)|^2; with_scale = false fixes s = 1 (the
 /// same optimum as Horn's closed form). Throws InputError(source, "positions")
 /// when fewer than 3 points are given or src does not spread (s undefined).
-Alignment umeyama_alignment(const std::vector<Vec3>& src, const std::vector<Vec3>& dst, bool with_scale,
-                            const std::string& source);
+Alignment umeyama_alignment(const std::vector<Vec3>& src, const std::vector<Vec3>& dst, bool with_scale, const std::string& source);
 
 /// The alignment of `mode` that maps est onto gt (pose sequences of equal length, already associated).
-Alignment compute_alignment(AlignMode mode, const std::vector<SE3>& gt, const std::vector<SE3>& est,
-                            const std::string& source);
+Alignment compute_alignment(AlignMode mode, const std::vector<SE3>& gt, const std::vector<SE3>& est, const std::string& source);
 
 }  // namespace mlidar::eval

@@ -29,13 +29,11 @@ std::vector<double> stamps_of(const Trajectory& trajectory) {
 
 void validate_trajectory(const Trajectory& trajectory, const std::string& source) {
   if (trajectory.size() < 2)
-    throw InputError(source, "poses",
-                     "has " + std::to_string(trajectory.size()) + " pose(s); at least 2 are needed to evaluate");
+    throw InputError(source, "poses", "has " + std::to_string(trajectory.size()) + " pose(s); at least 2 are needed to evaluate");
   for (std::size_t i = 0; i < trajectory.size(); ++i) {
     const StampedPose& pose = trajectory.poses[i];
     if (!std::isfinite(pose.stamp)) throw InputError(source, pose_field(i), "timestamp is not finite");
-    if (!pose.T_world_base.translation().allFinite())
-      throw InputError(source, pose_field(i), "translation is not finite (NaN or inf)");
+    if (!pose.T_world_base.translation().allFinite()) throw InputError(source, pose_field(i), "translation is not finite (NaN or inf)");
     const double norm = pose.T_world_base.rotation().coeffs().norm();
     if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3)
       throw InputError(source, pose_field(i), "rotation is not a unit quaternion (NaN or not normalised)");
@@ -71,8 +69,8 @@ Association associate_by_time(const Trajectory& gt, const Trajectory& est, doubl
   }
   if (from_shorter.size() < 2)
     throw InputError(est_source, "timestamp",
-                     "only " + std::to_string(from_shorter.size()) + " pose(s) lie within max_dt = " +
-                         std::to_string(max_dt) + " s of a ground-truth pose; check that both files use the same "
+                     "only " + std::to_string(from_shorter.size()) + " pose(s) lie within max_dt = " + std::to_string(max_dt) +
+                         " s of a ground-truth pose; check that both files use the same "
                          "clock or raise --max-dt");
   Association association;
   association.gt = gt_is_shorter ? std::move(from_shorter) : std::move(from_longer);
@@ -83,8 +81,8 @@ Association associate_by_time(const Trajectory& gt, const Trajectory& est, doubl
 Association associate_by_index(const Trajectory& gt, const Trajectory& est, const std::string& est_source) {
   if (gt.size() != est.size())
     throw InputError(est_source, "poses",
-                     "has " + std::to_string(est.size()) + " poses but the ground truth has " +
-                         std::to_string(gt.size()) + "; KITTI files are paired line by line");
+                     "has " + std::to_string(est.size()) + " poses but the ground truth has " + std::to_string(gt.size()) +
+                         "; KITTI files are paired line by line");
   Association association;
   association.gt.resize(gt.size());
   association.est.resize(gt.size());

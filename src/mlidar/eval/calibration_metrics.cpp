@@ -9,8 +9,7 @@
 
 namespace mlidar::eval {
 
-ExtrinsicError extrinsic_error(const SE3& T_base_lidar_gt, const SE3& T_base_lidar_est,
-                               const std::optional<Mat6>& covariance_est) {
+ExtrinsicError extrinsic_error(const SE3& T_base_lidar_gt, const SE3& T_base_lidar_est, const std::optional<Mat6>& covariance_est) {
   constexpr double kRadToDeg = 180.0 / std::numbers::pi;
   ExtrinsicError error;
   const Quat& R_gt = T_base_lidar_gt.rotation();
@@ -26,14 +25,12 @@ ExtrinsicError extrinsic_error(const SE3& T_base_lidar_gt, const SE3& T_base_lid
   return error;
 }
 
-std::vector<ExtrinsicError> evaluate_calibration(const io::Extrinsics& gt, const io::Extrinsics& est,
-                                                 const std::string& est_source) {
+std::vector<ExtrinsicError> evaluate_calibration(const io::Extrinsics& gt, const io::Extrinsics& est, const std::string& est_source) {
   std::vector<ExtrinsicError> errors;
   for (const io::LidarExtrinsic& truth : gt.lidars) {
-    const auto estimate = std::find_if(est.lidars.begin(), est.lidars.end(),
-                                       [&](const io::LidarExtrinsic& lidar) { return lidar.name == truth.name; });
-    if (estimate == est.lidars.end())
-      throw InputError(est_source, "lidars." + truth.name, "missing; the ground truth has this LiDAR");
+    const auto estimate =
+        std::find_if(est.lidars.begin(), est.lidars.end(), [&](const io::LidarExtrinsic& lidar) { return lidar.name == truth.name; });
+    if (estimate == est.lidars.end()) throw InputError(est_source, "lidars." + truth.name, "missing; the ground truth has this LiDAR");
     errors.push_back(extrinsic_error(truth.T_base_lidar, estimate->T_base_lidar, estimate->covariance));
     errors.back().name = truth.name;
   }

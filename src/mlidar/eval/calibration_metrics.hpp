@@ -25,12 +25,10 @@ struct ExtrinsicError {
 /// Error of one extrinsic. The NEES uses the error in the covariance's
 /// [t, r] tangent: t_gt = t_est + e_t, R_gt = R_est Exp(e_r), NEES = e^T Sigma^-1 e;
 /// it stays empty when the covariance is absent or not positive definite.
-ExtrinsicError extrinsic_error(const SE3& T_base_lidar_gt, const SE3& T_base_lidar_est,
-                               const std::optional<Mat6>& covariance_est);
+ExtrinsicError extrinsic_error(const SE3& T_base_lidar_gt, const SE3& T_base_lidar_est, const std::optional<Mat6>& covariance_est);
 
 /// One entry per LiDAR of `gt`, in its order. Throws InputError(est_source,
 /// "lidars.NAME", ...) when the estimate lacks a LiDAR of the ground truth.
-std::vector<ExtrinsicError> evaluate_calibration(const io::Extrinsics& gt, const io::Extrinsics& est,
-                                                 const std::string& est_source);
+std::vector<ExtrinsicError> evaluate_calibration(const io::Extrinsics& gt, const io::Extrinsics& est, const std::string& est_source);
 
 }  // namespace mlidar::eval

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <utility>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
@@ -21,8 +21,7 @@ constexpr std::size_t kLeafSize = 24;  // radius queries return many points: wid
 std::uint64_t morton_code(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   std::uint64_t code = 0;
   for (int bit = 0; bit < 21; ++bit) {
-    code |= (static_cast<std::uint64_t>((x >> bit) & 1U) << (3 * bit)) |
-            (static_cast<std::uint64_t>((y >> bit) & 1U) << (3 * bit + 1)) |
+    code |= (static_cast<std::uint64_t>((x >> bit) & 1U) << (3 * bit)) | (static_cast<std::uint64_t>((y >> bit) & 1U) << (3 * bit + 1)) |
             (static_cast<std::uint64_t>((z >> bit) & 1U) << (3 * bit + 2));
   }
   return code;
@@ -54,7 +53,7 @@ std::vector<Eigen::Vector3f> finite_points_in_spatial_order(const std::vector<Ei
 }
 
 struct LocalSpread {
-  double entropy = 0.0;         ///< 1/2 ln |2 pi e Sigma|
+  double entropy = 0.0;  ///< 1/2 ln |2 pi e Sigma|
   double smallest_variance = 0.0;
 };
 
@@ -80,8 +79,7 @@ bool local_spread(const Eigen::Matrix3d& covariance, LocalSpread& spread) {
   const Eigen::Vector3d& eigenvalues = solver.eigenvalues();  // increasing
   if (!(eigenvalues(0) > 1e-12 * std::max(eigenvalues(2), 1e-300))) return false;
   const double log_two_pi_e = std::log(2.0 * std::numbers::pi * std::numbers::e);
-  spread.entropy = 0.5 * (3.0 * log_two_pi_e + std::log(eigenvalues(0)) + std::log(eigenvalues(1)) +
-                          std::log(eigenvalues(2)));
+  spread.entropy = 0.5 * (3.0 * log_two_pi_e + std::log(eigenvalues(0)) + std::log(eigenvalues(1)) + std::log(eigenvalues(2)));
   spread.smallest_variance = eigenvalues(0);
   return true;
 }
@@ -92,8 +90,7 @@ MapMetrics compute_map_metrics(const std::vector<Eigen::Vector3f>& points, const
   if (!(options.radius > 0.0) || !std::isfinite(options.radius))
     throw std::invalid_argument("map metrics: radius must be a finite number > 0");
   if (options.min_neighbors < 4) throw std::invalid_argument("map metrics: min_neighbors must be >= 4");
-  if (points.size() >= std::numeric_limits<std::uint32_t>::max())
-    throw std::invalid_argument("map metrics: too many points");
+  if (points.size() >= std::numeric_limits<std::uint32_t>::max()) throw std::invalid_argument("map metrics: too many points");
   const KdTree3f tree(finite_points_in_spatial_order(points, options.radius), kLeafSize);
   const std::vector<Eigen::Vector3f>& cloud = tree.points();
   const auto radius = static_cast<float>(options.radius);

@@ -15,13 +15,13 @@
 namespace mlidar::eval {
 
 struct MapMetricsOptions {
-  double radius = 0.3;             ///< neighbourhood radius, metres (> 0)
-  std::size_t min_neighbors = 5;   ///< points with fewer neighbours (self included) are skipped (>= 4)
+  double radius = 0.3;            ///< neighbourhood radius, metres (> 0)
+  std::size_t min_neighbors = 5;  ///< points with fewer neighbours (self included) are skipped (>= 4)
 };
 
 struct MapMetrics {
-  std::size_t points = 0;       ///< points given
-  std::size_t points_used = 0;  ///< points with enough neighbours and a full-rank covariance
+  std::size_t points = 0;            ///< points given
+  std::size_t points_used = 0;       ///< points with enough neighbours and a full-rank covariance
   double mean_map_entropy = 0.0;     ///< NaN when points_used == 0
   double mean_plane_variance = 0.0;  ///< m^2; NaN when points_used == 0
 };

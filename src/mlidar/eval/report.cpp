@@ -17,17 +17,20 @@ std::string fixed(double value, int decimals = 4) {
 
 std::string stats_row(const char* label, const ErrorStats& stats) {
   char buffer[200];
-  std::snprintf(buffer, sizeof(buffer), "%-26s %10s %10s %10s %10s\n", label, fixed(stats.rmse).c_str(),
-                fixed(stats.mean).c_str(), fixed(stats.median).c_str(), fixed(stats.max).c_str());
+  std::snprintf(buffer, sizeof(buffer), "%-26s %10s %10s %10s %10s\n", label, fixed(stats.rmse).c_str(), fixed(stats.mean).c_str(),
+                fixed(stats.median).c_str(), fixed(stats.max).c_str());
   return buffer;
 }
 
 }  // namespace
 
 nlohmann::json to_json(const ErrorStats& stats) {
-  return {{"count", stats.count},           {"rmse", number_or_null(stats.rmse)},
-          {"mean", number_or_null(stats.mean)}, {"median", number_or_null(stats.median)},
-          {"std", number_or_null(stats.std)},   {"min", number_or_null(stats.min)},
+  return {{"count", stats.count},
+          {"rmse", number_or_null(stats.rmse)},
+          {"mean", number_or_null(stats.mean)},
+          {"median", number_or_null(stats.median)},
+          {"std", number_or_null(stats.std)},
+          {"min", number_or_null(stats.min)},
           {"max", number_or_null(stats.max)}};
 }
 
@@ -83,9 +86,9 @@ nlohmann::json to_json(const MapMetrics& metrics, const MapMetricsOptions& optio
 }
 
 std::string format_table(const TrajectoryReport& report) {
-  std::string text = "poses: " + std::to_string(report.gt.size()) + " matched (gt " + std::to_string(report.gt_poses) +
-                     ", est " + std::to_string(report.est_poses) + "), alignment " +
-                     align_mode_name(report.alignment.mode) + ", scale " + fixed(report.alignment.scale, 6) + "\n";
+  std::string text = "poses: " + std::to_string(report.gt.size()) + " matched (gt " + std::to_string(report.gt_poses) + ", est " +
+                     std::to_string(report.est_poses) + "), alignment " + align_mode_name(report.alignment.mode) + ", scale " +
+                     fixed(report.alignment.scale, 6) + "\n";
   char header[200];
   std::snprintf(header, sizeof(header), "%-26s %10s %10s %10s %10s\n", "metric", "rmse", "mean", "median", "max");
   text += header;
@@ -98,9 +101,8 @@ std::string format_table(const TrajectoryReport& report) {
   text += stats_row((rpe + " trans (%)").c_str(), report.rpe.translation_percent);
   text += stats_row((rpe + " rot (deg)").c_str(), report.rpe.rotation_deg);
   if (report.kitti.has_value()) {
-    text += "KITTI odometry: " + fixed(report.kitti->translation_percent) + " %, " +
-            fixed(report.kitti->rotation_deg_per_100m) + " deg/100m over " + std::to_string(report.kitti->segments) +
-            " segments\n";
+    text += "KITTI odometry: " + fixed(report.kitti->translation_percent) + " %, " + fixed(report.kitti->rotation_deg_per_100m) +
+            " deg/100m over " + std::to_string(report.kitti->segments) + " segments\n";
   } else {
     text += "KITTI odometry: path shorter than 100 m, not computed\n";
   }
@@ -112,11 +114,9 @@ std::string format_table(const std::vector<ExtrinsicError>& errors) {
   std::snprintf(line, sizeof(line), "%-16s %12s %12s %12s\n", "lidar", "rot (deg)", "trans (m)", "NEES (<=12.59)");
   std::string text = line;
   for (const ExtrinsicError& error : errors) {
-    const std::string nees = error.nees.has_value()
-                                 ? fixed(*error.nees, 3) + (error.nees_within_95() ? " ok" : " OUT")
-                                 : std::string("-");
-    std::snprintf(line, sizeof(line), "%-16s %12s %12s %12s\n", error.name.c_str(),
-                  fixed(error.rotation_error_deg).c_str(), fixed(error.translation_error_m).c_str(), nees.c_str());
+    const std::string nees = error.nees.has_value() ? fixed(*error.nees, 3) + (error.nees_within_95() ? " ok" : " OUT") : std::string("-");
+    std::snprintf(line, sizeof(line), "%-16s %12s %12s %12s\n", error.name.c_str(), fixed(error.rotation_error_deg).c_str(),
+                  fixed(error.translation_error_m).c_str(), nees.c_str());
     text += line;
   }
   return text;

@@ -30,8 +30,8 @@ std::string number(double value) {
 }
 
 /// <polyline> through (xs[i], ys[i]) mapped into `box`, y up.
-std::string polyline(const std::vector<double>& xs, const std::vector<double>& ys, Range x_range, Range y_range,
-                     const Box& box, const char* colour) {
+std::string polyline(const std::vector<double>& xs, const std::vector<double>& ys, Range x_range, Range y_range, const Box& box,
+                     const char* colour) {
   const std::size_t stride = std::max<std::size_t>(1, (xs.size() + kMaxVertices - 1) / kMaxVertices);
   std::ostringstream out;
   out << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"1.5\" points=\"";
@@ -47,17 +47,16 @@ std::string polyline(const std::vector<double>& xs, const std::vector<double>& y
 std::string frame(const Box& box, const std::string& title, Range x_range, Range y_range, const std::string& x_label,
                   const std::string& y_label) {
   std::ostringstream out;
-  out << "<rect x=\"" << box.left << "\" y=\"" << box.top << "\" width=\"" << box.width << "\" height=\""
-      << box.height << "\" fill=\"none\" stroke=\"#444\"/>\n";
+  out << "<rect x=\"" << box.left << "\" y=\"" << box.top << "\" width=\"" << box.width << "\" height=\"" << box.height
+      << "\" fill=\"none\" stroke=\"#444\"/>\n";
   out << "<text x=\"" << box.left << "\" y=\"" << box.top - 8 << "\">" << title << "</text>\n";
-  out << "<text x=\"" << box.left << "\" y=\"" << box.top + box.height + 16 << "\">" << number(x_range.lo)
+  out << "<text x=\"" << box.left << "\" y=\"" << box.top + box.height + 16 << "\">" << number(x_range.lo) << "</text>\n";
+  out << "<text x=\"" << box.left + box.width << "\" y=\"" << box.top + box.height + 16 << "\" text-anchor=\"end\">" << number(x_range.hi)
+      << ' ' << x_label << "</text>\n";
+  out << "<text x=\"" << box.left - 4 << "\" y=\"" << box.top + box.height << "\" text-anchor=\"end\">" << number(y_range.lo)
       << "</text>\n";
-  out << "<text x=\"" << box.left + box.width << "\" y=\"" << box.top + box.height + 16
-      << "\" text-anchor=\"end\">" << number(x_range.hi) << ' ' << x_label << "</text>\n";
-  out << "<text x=\"" << box.left - 4 << "\" y=\"" << box.top + box.height << "\" text-anchor=\"end\">"
-      << number(y_range.lo) << "</text>\n";
-  out << "<text x=\"" << box.left - 4 << "\" y=\"" << box.top + 10 << "\" text-anchor=\"end\">" << number(y_range.hi)
-      << ' ' << y_label << "</text>\n";
+  out << "<text x=\"" << box.left - 4 << "\" y=\"" << box.top + 10 << "\" text-anchor=\"end\">" << number(y_range.hi) << ' ' << y_label
+      << "</text>\n";
   return out.str();
 }
 
@@ -72,8 +71,8 @@ void make_equal_scale(Range& x, Range& y) {
 
 }  // namespace
 
-std::string trajectory_plot_svg(const std::vector<SE3>& gt, const std::vector<SE3>& est,
-                                const std::vector<double>& stamps, const std::vector<double>& ate_m) {
+std::string trajectory_plot_svg(const std::vector<SE3>& gt, const std::vector<SE3>& est, const std::vector<double>& stamps,
+                                const std::vector<double>& ate_m) {
   const std::size_t n = std::min({gt.size(), est.size(), stamps.size(), ate_m.size()});
   std::vector<double> gt_x(n), gt_y(n), est_x(n), est_y(n), times(n), errors(ate_m.begin(), ate_m.begin() + static_cast<std::ptrdiff_t>(n));
   for (std::size_t i = 0; i < n; ++i) {

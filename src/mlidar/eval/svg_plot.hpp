@@ -12,7 +12,7 @@ namespace mlidar::eval {
 /// The SVG document. gt, est, stamps and ate_m have one entry per associated
 /// pose (same length, at least 1). Long trajectories are thinned to at most
 /// 4000 vertices per line so the file stays small.
-std::string trajectory_plot_svg(const std::vector<SE3>& gt, const std::vector<SE3>& est,
-                                const std::vector<double>& stamps, const std::vector<double>& ate_m);
+std::string trajectory_plot_svg(const std::vector<SE3>& gt, const std::vector<SE3>& est, const std::vector<double>& stamps,
+                                const std::vector<double>& ate_m);
 
 }  // namespace mlidar::eval

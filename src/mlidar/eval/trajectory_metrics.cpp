@@ -109,8 +109,7 @@ std::optional<KittiOdometryResult> compute_kitti_odometry(const std::vector<SE3>
   for (std::size_t first = 0; first < gt.size(); first += kStepFrames) {
     for (const double length : kLengths) {
       // devkit lastFrameFromSegmentLength: first frame with dist > dist[first] + length
-      const auto it = std::upper_bound(distances.begin() + static_cast<std::ptrdiff_t>(first), distances.end(),
-                                       distances[first] + length);
+      const auto it = std::upper_bound(distances.begin() + static_cast<std::ptrdiff_t>(first), distances.end(), distances[first] + length);
       if (it == distances.end()) continue;
       const auto last = static_cast<std::size_t>(it - distances.begin());
       const SE3 delta_gt = gt[first].inverse() * gt[last];
@@ -134,9 +133,8 @@ TrajectoryReport evaluate_trajectory(const Trajectory& gt, const Trajectory& est
   validate_options(options);
   validate_trajectory(gt, gt_source);
   validate_trajectory(est, est_source);
-  const Association association = options.associate_by_index
-                                      ? associate_by_index(gt, est, est_source)
-                                      : associate_by_time(gt, est, options.max_dt, est_source);
+  const Association association =
+      options.associate_by_index ? associate_by_index(gt, est, est_source) : associate_by_time(gt, est, options.max_dt, est_source);
   TrajectoryReport report;
   report.options = options;
   report.gt_poses = gt.size();

@@ -46,8 +46,8 @@ RpeResult compute_rpe(const std::vector<SE3>& gt, const std::vector<SE3>& est, d
 /// all segments. Empty when the path is shorter than 100 m.
 struct KittiOdometryResult {
   std::size_t segments = 0;
-  double translation_percent = 0.0;     ///< mean t_err / length * 100
-  double rotation_deg_per_100m = 0.0;   ///< mean r_err / length, in deg per 100 m
+  double translation_percent = 0.0;    ///< mean t_err / length * 100
+  double rotation_deg_per_100m = 0.0;  ///< mean r_err / length, in deg per 100 m
 };
 std::optional<KittiOdometryResult> compute_kitti_odometry(const std::vector<SE3>& gt, const std::vector<SE3>& est);
 
@@ -64,11 +64,11 @@ struct TrajectoryReport {
   std::size_t gt_poses = 0;
   std::size_t est_poses = 0;
   Alignment alignment;
-  std::vector<double> stamps;      ///< ground-truth stamps of the associated poses
-  std::vector<SE3> gt;             ///< associated ground-truth poses
-  std::vector<SE3> est_aligned;    ///< associated estimated poses after alignment
+  std::vector<double> stamps;    ///< ground-truth stamps of the associated poses
+  std::vector<SE3> gt;           ///< associated ground-truth poses
+  std::vector<SE3> est_aligned;  ///< associated estimated poses after alignment
   AteResult ate;
-  RpeResult rpe;                   ///< on the aligned estimate (matters for sim3)
+  RpeResult rpe;  ///< on the aligned estimate (matters for sim3)
   std::optional<KittiOdometryResult> kitti;
 };
 

@@ -17,11 +17,12 @@ struct PointsAdaptor {
   std::size_t kdtree_get_point_count() const { return points->size(); }
   float kdtree_get_pt(std::size_t index, std::size_t dim) const { return (*points)[index][static_cast<Eigen::Index>(dim)]; }
   template <class BoundingBox>
-  bool kdtree_get_bbox(BoundingBox& /*unused*/) const { return false; }
+  bool kdtree_get_bbox(BoundingBox& /*unused*/) const {
+    return false;
+  }
 };
 
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>, PointsAdaptor, 3,
-                                                 std::uint32_t>;
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>, PointsAdaptor, 3, std::uint32_t>;
 
 /// Result set that appends every point inside the radius straight into a Neighbor vector.
 class RadiusCollector {
@@ -49,8 +50,7 @@ void check_points(const std::vector<Eigen::Vector3f>& points) {
   if (points.size() >= std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("KdTree3f: too many points (" + std::to_string(points.size()) + ")");
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!points[i].allFinite())
-      throw std::invalid_argument("KdTree3f: point " + std::to_string(i) + " is not finite");
+    if (!points[i].allFinite()) throw std::invalid_argument("KdTree3f: point " + std::to_string(i) + " is not finite");
   }
 }
 

@@ -11,8 +11,8 @@ namespace {
 using Index = std::uint32_t;
 
 /// Inliers of `plane` among `candidates` (float distances: the hot loop).
-std::vector<Index> collect_inliers(std::span<const Eigen::Vector3f> points, const std::vector<Index>& candidates,
-                                   const Plane& plane, double threshold) {
+std::vector<Index> collect_inliers(std::span<const Eigen::Vector3f> points, const std::vector<Index>& candidates, const Plane& plane,
+                                   double threshold) {
   const Eigen::Vector3f n = plane.normal.cast<float>();
   const float d = static_cast<float>(plane.offset);
   const float limit = static_cast<float>(threshold);
@@ -23,8 +23,8 @@ std::vector<Index> collect_inliers(std::span<const Eigen::Vector3f> points, cons
   return inliers;
 }
 
-std::size_t count_inliers(std::span<const Eigen::Vector3f> points, const std::vector<Index>& candidates,
-                          const Eigen::Vector3f& n, float d, float limit) {
+std::size_t count_inliers(std::span<const Eigen::Vector3f> points, const std::vector<Index>& candidates, const Eigen::Vector3f& n, float d,
+                          float limit) {
   std::size_t count = 0;
   for (const Index i : candidates) count += std::abs(n.dot(points[i]) + d) <= limit ? 1U : 0U;
   return count;
@@ -41,8 +41,8 @@ int needed_iterations(std::size_t inliers, std::size_t total, int cap) {
 }
 
 /// Best 3-point hypothesis by inlier count (eq 2.1 distance).
-Plane best_hypothesis(std::span<const Eigen::Vector3f> points, const std::vector<Index>& candidates,
-                      const PlaneRansacConfig& config, std::mt19937_64& rng) {
+Plane best_hypothesis(std::span<const Eigen::Vector3f> points, const std::vector<Index>& candidates, const PlaneRansacConfig& config,
+                      std::mt19937_64& rng) {
   std::uniform_int_distribution<std::size_t> pick(0, candidates.size() - 1);
   const float limit = static_cast<float>(config.inlier_distance);
   Plane best;
@@ -68,8 +68,8 @@ Plane best_hypothesis(std::span<const Eigen::Vector3f> points, const std::vector
 }
 
 void check(const PlaneRansacConfig& config, std::size_t size) {
-  if (!(config.inlier_distance > 0.0) || config.max_iterations < 1 || config.min_inliers < 3 ||
-      config.max_planes < 1 || config.refine_passes < 0)
+  if (!(config.inlier_distance > 0.0) || config.max_iterations < 1 || config.min_inliers < 3 || config.max_planes < 1 ||
+      config.refine_passes < 0)
     throw std::invalid_argument("extract_planes: config out of range");
   if (size >= std::numeric_limits<Index>::max()) throw std::invalid_argument("extract_planes: 2^32 points or more");
 }

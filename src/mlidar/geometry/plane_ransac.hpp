@@ -12,11 +12,11 @@
 namespace mlidar {
 
 struct PlaneRansacConfig {
-  double inlier_distance = 0.2;    ///< m, |n.p + d| below this is an inlier
-  int max_iterations = 1000;       ///< hypotheses per plane at most (fewer once 99.9 % confident)
-  std::size_t min_inliers = 100;   ///< stop when the best plane has fewer
-  int max_planes = 6;              ///< planes to extract at most
-  int refine_passes = 3;           ///< fit-then-recollect passes after the best hypothesis
+  double inlier_distance = 0.2;   ///< m, |n.p + d| below this is an inlier
+  int max_iterations = 1000;      ///< hypotheses per plane at most (fewer once 99.9 % confident)
+  std::size_t min_inliers = 100;  ///< stop when the best plane has fewer
+  int max_planes = 6;             ///< planes to extract at most
+  int refine_passes = 3;          ///< fit-then-recollect passes after the best hypothesis
   std::uint64_t seed = 1;
 };
 

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
+#include <span>
+#include <string_view>
 
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/file_bytes.hpp"
 #include "mlidar/io/kitti.hpp"
 #include "mlidar/io/pcd.hpp"
 #include "mlidar/io/ply.hpp"
@@ -12,9 +16,12 @@ namespace mlidar::io {
 
 const char* cloud_format_name(CloudFormat format) {
   switch (format) {
-    case CloudFormat::kPcd: return "pcd";
-    case CloudFormat::kPly: return "ply";
-    case CloudFormat::kKittiBin: return "kitti-bin";
+    case CloudFormat::kPcd:
+      return "pcd";
+    case CloudFormat::kPly:
+      return "ply";
+    case CloudFormat::kKittiBin:
+      return "kitti-bin";
   }
   return "?";
 }
@@ -30,12 +37,22 @@ bool ends_with(const std::string& text, const std::string& suffix) {
   return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-int guess_bin_floats(const std::filesystem::path& path) {
+int guess_bin_floats(const std::filesystem::path& path, std::size_t size) {
   if (ends_with(lower(path.filename().string()), ".pcd.bin")) return 5;
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size % 16 != 0 && size % 20 == 0) return 5;
+  if (size % 16 != 0 && size % 20 == 0) return 5;
   return 4;
+}
+
+bool starts_with(std::span<const std::byte> bytes, std::string_view text) {
+  return bytes.size() >= text.size() && std::memcmp(bytes.data(), text.data(), text.size()) == 0;
+}
+
+/// A stream's format from its first bytes: "ply" opens a PLY file, a PCD header opens with a comment, VERSION or
+/// FIELDS; anything else is read as float32 points (.bin).
+CloudFormat sniff_format(std::span<const std::byte> bytes) {
+  if (starts_with(bytes, "ply\n") || starts_with(bytes, "ply\r\n")) return CloudFormat::kPly;
+  if (starts_with(bytes, "#") || starts_with(bytes, "VERSION") || starts_with(bytes, "FIELDS")) return CloudFormat::kPcd;
+  return CloudFormat::kKittiBin;
 }
 
 PcdEncoding parse_pcd_encoding(const std::string& name) {
@@ -63,31 +80,35 @@ CloudFormat cloud_format_of(const std::filesystem::path& path) {
   if (extension == ".pcd") return CloudFormat::kPcd;
   if (extension == ".ply") return CloudFormat::kPly;
   if (extension == ".bin") return CloudFormat::kKittiBin;
-  throw InputError(path.string(), "file extension", "unknown point-cloud format '" + extension +
-                                                         "' (mlidar reads .pcd, .ply and KITTI/nuScenes .bin)");
+  throw InputError(path.string(), "file extension",
+                   "unknown point-cloud format '" + extension + "' (mlidar reads .pcd, .ply and KITTI/nuScenes .bin)");
 }
 
 CloudFile read_cloud(const std::filesystem::path& path, const CloudReadOptions& options) {
+  const bool stream = is_stream_path(path);
+  const CloudFormat named = stream ? CloudFormat::kPcd : cloud_format_of(path);  // an unknown extension fails before reading
+  const std::vector<std::byte> bytes = read_file_bytes(path);
+  const std::string source = path.string();
   CloudFile cloud;
-  cloud.format = cloud_format_of(path);
+  cloud.format = stream ? sniff_format(bytes) : named;
   switch (cloud.format) {
     case CloudFormat::kPcd: {
-      PcdCloud pcd = read_pcd(path, PcdReadOptions{options.drop_nan});
+      PcdCloud pcd = parse_pcd(bytes, source, PcdReadOptions{options.drop_nan});
       cloud.encoding = pcd_encoding_name(pcd.encoding);
       cloud.viewpoint = pcd.viewpoint;
       cloud.table = std::move(pcd.table);
       break;
     }
     case CloudFormat::kPly: {
-      PlyCloud ply = read_ply(path);
+      PlyCloud ply = parse_ply(bytes, source);
       cloud.encoding = ply_encoding_name(ply.encoding);
       cloud.table = std::move(ply.table);
       break;
     }
     case CloudFormat::kKittiBin: {
-      const int floats = options.bin_floats_per_point > 0 ? options.bin_floats_per_point : guess_bin_floats(path);
+      const int floats = options.bin_floats_per_point > 0 ? options.bin_floats_per_point : guess_bin_floats(path, bytes.size());
       cloud.encoding = floats == 5 ? "float32 x5 (nuScenes)" : "float32 x4 (KITTI)";
-      cloud.table = read_kitti_bin(path, floats);
+      cloud.table = parse_kitti_bin(bytes, source, floats);
       break;
     }
   }
@@ -110,7 +131,9 @@ void write_cloud(const std::filesystem::path& path, const CloudFile& cloud, cons
       write_ply(path, ply);
       return;
     }
-    case CloudFormat::kKittiBin: write_kitti_bin(path, cloud.table); return;
+    case CloudFormat::kKittiBin:
+      write_kitti_bin(path, cloud.table);
+      return;
   }
 }
 

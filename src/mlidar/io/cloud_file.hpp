@@ -26,11 +26,12 @@ struct CloudReadOptions {
 
 struct CloudFile {
   CloudFormat format = CloudFormat::kPcd;
-  std::string encoding;                                ///< "binary", "ascii", "binary_compressed", "binary_little_endian", ...
+  std::string encoding;                                  ///< "binary", "ascii", "binary_compressed", "binary_little_endian", ...
   std::array<double, 7> viewpoint{0, 0, 0, 1, 0, 0, 0};  ///< PCD only: tx ty tz qw qx qy qz
   PointTable table;
 };
 
+/// The format comes from the extension; for "-" (standard input) and pipes (/dev/fd/N) from the first bytes.
 CloudFile read_cloud(const std::filesystem::path& path, const CloudReadOptions& options = {});
 
 struct CloudWriteOptions {

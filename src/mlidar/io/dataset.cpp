@@ -44,15 +44,29 @@ class Checker : public YamlFields {
     return SE3(rotation.normalized(), Vec3(t[0], t[1], t[2]));
   }
 
+  /// One elevation per ring in ring order: ring r is the r-th smallest (slam/range_image.hpp).
+  std::vector<double> increasing_angles(const YAML::Node& node, const std::string& key) const {
+    std::vector<double> angles = numbers(node, key, 0);
+    for (std::size_t i = 1; i < angles.size(); ++i) {
+      if (!(angles[i] > angles[i - 1]))
+        fail(key + "[" + std::to_string(i) + "]",
+             "must be greater than the angle before it (list the rings' elevations in increasing order, "
+             "each once; ring r is the r-th lowest beam)");
+    }
+    return angles;
+  }
+
   DatasetLidar lidar(const YAML::Node& node, const std::string& key) const {
-    only_keys(node, key, {"name", "model", "scans", "vertical_angles_deg", "horizontal_resolution_deg", "min_range",
-                          "max_range", "initial_extrinsic"});
+    only_keys(node, key,
+              {"name", "model", "scans", "vertical_angles_deg", "horizontal_resolution_deg", "min_range", "max_range", "initial_extrinsic",
+               "time_unit"});
     DatasetLidar lidar;
     lidar.name = text(node["name"], key + ".name");
     if (!std::regex_match(lidar.name, std::regex("[A-Za-z0-9_-]+"))) fail(key + ".name", "use letters, digits, '_' or '-'");
     lidar.model.name = text(node["model"], key + ".model");
     lidar.scans = inner_path(node["scans"], key + ".scans");
-    if (node["vertical_angles_deg"]) lidar.model.vertical_angles_deg = numbers(node["vertical_angles_deg"], key + ".vertical_angles_deg", 0);
+    if (node["vertical_angles_deg"])
+      lidar.model.vertical_angles_deg = increasing_angles(node["vertical_angles_deg"], key + ".vertical_angles_deg");
     auto positive = [&](const char* field, double& out) {
       if (!node[field]) return;
       out = number(node[field], key + "." + field);
@@ -61,11 +75,48 @@ class Checker : public YamlFields {
     positive("horizontal_resolution_deg", lidar.model.horizontal_resolution_deg);
     positive("min_range", lidar.model.min_range);
     positive("max_range", lidar.model.max_range);
+    if (!(lidar.model.max_range > lidar.model.min_range))
+      fail(key + ".max_range", "must be greater than min_range (" + std::to_string(lidar.model.min_range) + " m)");
+    if (node["time_unit"]) {
+      const auto unit = parse_time_unit(text(node["time_unit"], key + ".time_unit"));
+      if (!unit) fail(key + ".time_unit", "expected s, ms, us, ns or auto");
+      lidar.time_unit = *unit;
+    }
     if (node["initial_extrinsic"]) lidar.initial_extrinsic = extrinsic(node["initial_extrinsic"], key + ".initial_extrinsic");
     return lidar;
   }
-
 };
+
+const DatasetLidar* find_lidar(const Dataset& dataset, const std::string& name) {
+  for (const auto& lidar : dataset.lidars)
+    if (lidar.name == name) return &lidar;
+  return nullptr;
+}
+
+/// The base frame is a LiDAR (its extrinsic, if given, is identity) or a frame that reference_lidar places.
+void check_base(const Checker& check, const YAML::Node& root, Dataset& dataset) {
+  if (root["reference_lidar"]) dataset.reference_lidar = check.text(root["reference_lidar"], "reference_lidar");
+  if (const DatasetLidar* base = find_lidar(dataset, dataset.base)) {
+    if (!dataset.reference_lidar.empty() && dataset.reference_lidar != dataset.base)
+      check.fail("reference_lidar",
+                 "is for a base frame that is no LiDAR; the base LiDAR " + dataset.base + " places the frame (remove it)");
+    dataset.reference_lidar.clear();
+    if (base->initial_extrinsic && !base->initial_extrinsic->log().isZero(1e-9))
+      check.fail("base", "the base LiDAR " + dataset.base + " defines the base frame: its initial_extrinsic must be the identity");
+    return;
+  }
+  std::string listed;
+  for (const auto& lidar : dataset.lidars) listed += (listed.empty() ? "" : ", ") + lidar.name;
+  if (dataset.reference_lidar.empty())
+    check.fail("base", "names no LiDAR of lidars (" + listed +
+                           "); name the base LiDAR, or, for a frame that is no LiDAR (the vehicle's), "
+                           "add reference_lidar: the LiDAR whose initial_extrinsic places it");
+  const DatasetLidar* reference = find_lidar(dataset, dataset.reference_lidar);
+  if (reference == nullptr) check.fail("reference_lidar", "names no LiDAR of lidars (" + listed + ")");
+  if (!reference->initial_extrinsic)
+    check.fail("reference_lidar",
+               "the LiDAR " + reference->name + " needs its initial_extrinsic: it places the base frame " + dataset.base);
+}
 
 void emit_numbers(YAML::Emitter& out, std::span<const double> values) {
   out << YAML::Flow << YAML::BeginSeq;
@@ -78,12 +129,13 @@ void emit_numbers(YAML::Emitter& out, std::span<const double> values) {
 Dataset parse_dataset_yaml(const std::string& text, const std::string& source) {
   const Checker check(source);
   const YAML::Node root = check.load(text);
-  check.only_keys(root, "", {"name", "frame_period", "base", "times", "lidars", "groundtruth"});
+  check.only_keys(root, "", {"name", "frame_period", "base", "reference_lidar", "times", "lidars", "groundtruth"});
   Dataset dataset;
   dataset.name = check.text(root["name"], "name");
   dataset.frame_period = check.number(root["frame_period"], "frame_period");
   if (dataset.frame_period <= 0.0) check.fail("frame_period", "expected a positive number of seconds");
-  if (root["base"]) dataset.base = check.text(root["base"], "base");
+  if (!root["base"]) check.fail("base", "missing (name the LiDAR whose frame is the base frame, e.g. base: top)");
+  dataset.base = check.text(root["base"], "base");
   if (root["times"]) dataset.times = check.inner_path(root["times"], "times");
   const YAML::Node lidars = root["lidars"];
   if (!lidars || !lidars.IsSequence() || lidars.size() == 0) check.fail("lidars", "expected a non-empty list of LiDARs");
@@ -93,6 +145,7 @@ Dataset parse_dataset_yaml(const std::string& text, const std::string& source) {
     dataset.lidars.push_back(check.lidar(lidars[i], key));
     if (!names.insert(dataset.lidars.back().name).second) check.fail(key + ".name", "duplicate LiDAR name");
   }
+  check_base(check, root, dataset);
   if (const YAML::Node truth = root["groundtruth"]) {
     check.only_keys(truth, "groundtruth", {"trajectory", "extrinsics", "boxes"});
     if (truth["trajectory"]) dataset.groundtruth.trajectory = check.inner_path(truth["trajectory"], "groundtruth.trajectory");
@@ -113,6 +166,7 @@ std::string format_dataset_yaml(const Dataset& dataset) {
   out << YAML::BeginMap << YAML::Key << "name" << YAML::Value << dataset.name;
   out << YAML::Key << "frame_period" << YAML::Value << exact_number(dataset.frame_period);
   out << YAML::Key << "base" << YAML::Value << dataset.base;
+  if (!dataset.reference_lidar.empty()) out << YAML::Key << "reference_lidar" << YAML::Value << dataset.reference_lidar;
   out << YAML::Key << "times" << YAML::Value << dataset.times.generic_string();
   out << YAML::Key << "lidars" << YAML::Value << YAML::BeginSeq;
   for (const auto& lidar : dataset.lidars) {
@@ -126,6 +180,7 @@ std::string format_dataset_yaml(const Dataset& dataset) {
     out << YAML::Key << "horizontal_resolution_deg" << YAML::Value << exact_number(lidar.model.horizontal_resolution_deg);
     out << YAML::Key << "min_range" << YAML::Value << exact_number(lidar.model.min_range);
     out << YAML::Key << "max_range" << YAML::Value << exact_number(lidar.model.max_range);
+    if (lidar.time_unit != TimeUnit::kAuto) out << YAML::Key << "time_unit" << YAML::Value << time_unit_name(lidar.time_unit);
     if (lidar.initial_extrinsic) {
       const SE3& T = *lidar.initial_extrinsic;
       const Vec3& t = T.translation();

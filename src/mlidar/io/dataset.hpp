@@ -8,16 +8,22 @@
 // dataset.yaml (unknown keys are errors naming the key):
 //   name: rv-campus-vehicle
 //   frame_period: 0.1                 # seconds, > 0
-//   base: top                         # base frame name
+//   base: top                         # the base frame: one of the lidars, or a frame that is
+//                                     # none of them (e.g. the vehicle's); then
+//   reference_lidar: top              # names the LiDAR that places it: its initial_extrinsic
+//                                     # (required) is T_base_lidar, known; the jobs estimate in
+//                                     # its frame and write their results in the base frame
 //   times: times.txt                  # optional, default times.txt
 //   lidars:
 //     - name: top                     # [A-Za-z0-9_-]+, unique
 //       model: RS-LiDAR-16            # model name
 //       scans: scans/top              # folder relative to DIR (no "..")
-//       vertical_angles_deg: [...]    # optional intrinsics
+//       vertical_angles_deg: [...]    # optional intrinsics, strictly increasing (ring order)
 //       horizontal_resolution_deg: 0.2
 //       min_range: 0.4
-//       max_range: 150
+//       max_range: 150                # > min_range
+//       time_unit: ns                 # optional: s, ms, us or ns of the per-point time
+//                                     # field (default from its type, io/point_table.hpp)
 //       initial_extrinsic:            # optional T_base_lidar guess, p_base = R p_lidar + t
 //         translation: [x, y, z]
 //         quaternion_wxyz: [w, x, y, z]
@@ -32,6 +38,7 @@
 #include <vector>
 
 #include "mlidar/core/types.hpp"
+#include "mlidar/io/point_table.hpp"
 
 namespace mlidar::io {
 
@@ -40,6 +47,7 @@ struct DatasetLidar {
   LidarModel model;                      ///< name always; intrinsics when given
   std::filesystem::path scans;           ///< relative to the dataset folder
   std::optional<SE3> initial_extrinsic;  ///< T_base_lidar guess
+  TimeUnit time_unit = TimeUnit::kAuto;  ///< of its clouds' per-point time field
 };
 
 struct DatasetGroundTruth {
@@ -51,7 +59,8 @@ struct DatasetGroundTruth {
 struct Dataset {
   std::string name;
   double frame_period = 0.1;
-  std::string base = "base";
+  std::string base;             ///< the base frame: a LiDAR's name, or a frame that is no LiDAR (then reference_lidar)
+  std::string reference_lidar;  ///< the LiDAR that places a base frame that is no LiDAR; empty when base is a LiDAR
   std::filesystem::path times = "times.txt";
   std::vector<DatasetLidar> lidars;
   DatasetGroundTruth groundtruth;

@@ -5,13 +5,14 @@
 #include <cmath>
 #include <set>
 
-#include <Eigen/Eigenvalues>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Eigenvalues>
 
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/io/text_fields.hpp"
+#include "mlidar/io/yaml_fields.hpp"
 
 namespace mlidar::io {
 namespace {
@@ -20,8 +21,7 @@ constexpr double kQuaternionNormTolerance = 1e-6;
 constexpr double kSymmetryTolerance = 1e-9;     // relative to the largest |entry|
 constexpr double kEigenvalueTolerance = 1e-12;  // relative to the largest |entry|
 
-void check_keys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& path,
-                const std::string& source) {
+void check_keys(const YAML::Node& map, const std::set<std::string>& allowed, const std::string& path, const std::string& source) {
   for (const auto& entry : map) {
     const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "<non-scalar key>";
     if (!allowed.contains(key)) {
@@ -32,11 +32,11 @@ void check_keys(const YAML::Node& map, const std::set<std::string>& allowed, con
   }
 }
 
-std::vector<double> finite_numbers(const YAML::Node& node, std::size_t expected, const std::string& path,
-                                   const std::string& source) {
+std::vector<double> finite_numbers(const YAML::Node& node, std::size_t expected, const std::string& path, const std::string& source) {
   if (!node.IsSequence() || node.size() != expected) {
-    throw InputError(source, path, "expected a list of " + std::to_string(expected) + " numbers" +
-                                       (node.IsSequence() ? ", found " + std::to_string(node.size()) : std::string()));
+    throw InputError(source, path,
+                     "expected a list of " + std::to_string(expected) + " numbers" +
+                         (node.IsSequence() ? ", found " + std::to_string(node.size()) : std::string()));
   }
   std::vector<double> values;
   for (std::size_t i = 0; i < expected; ++i) {
@@ -98,7 +98,8 @@ Extrinsics parse_document(const YAML::Node& root, const std::string& source) {
   if (!lidars.IsMap() || lidars.size() == 0) throw InputError(source, "lidars", "expected a non-empty mapping NAME: {...}");
   std::set<std::string> names;
   for (const auto& entry : lidars) {
-    if (!entry.first.IsScalar() || entry.first.Scalar().empty()) throw InputError(source, "lidars", "LiDAR names must be non-empty strings");
+    if (!entry.first.IsScalar() || entry.first.Scalar().empty())
+      throw InputError(source, "lidars", "LiDAR names must be non-empty strings");
     const std::string name = entry.first.Scalar();
     if (!names.insert(name).second) throw InputError(source, "lidars." + name, "duplicate LiDAR name");
     extrinsics.lidars.push_back(parse_lidar(name, entry.second, source));
@@ -125,8 +126,9 @@ const LidarExtrinsic* Extrinsics::find(const std::string& name) const& {
 }
 
 Extrinsics parse_extrinsics(const std::string& yaml_text, const std::string& source) {
+  const YAML::Node root = YamlFields(source, "extrinsics YAML").load(yaml_text);
   try {
-    return parse_document(YAML::Load(yaml_text), source);
+    return parse_document(root, source);
   } catch (const YAML::Exception& e) {
     throw InputError(source, "yaml", std::string("not valid YAML: ") + e.what());
   }

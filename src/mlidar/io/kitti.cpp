@@ -44,8 +44,8 @@ PointTable parse_kitti_bin(std::span<const std::byte> bytes, const std::string& 
   const std::size_t point_bytes = 4 * static_cast<std::size_t>(floats_per_point);
   if (bytes.size() % point_bytes != 0) {
     throw InputError(source, "file size",
-                     std::to_string(bytes.size()) + " bytes is not a multiple of " + std::to_string(point_bytes) +
-                         " (" + std::to_string(floats_per_point) + " float32 per point; truncated file or wrong floats_per_point?)");
+                     std::to_string(bytes.size()) + " bytes is not a multiple of " + std::to_string(point_bytes) + " (" +
+                         std::to_string(floats_per_point) + " float32 per point; truncated file or wrong floats_per_point?)");
   }
   PointTable table;
   table.num_points = bytes.size() / point_bytes;
@@ -81,26 +81,25 @@ void write_kitti_bin(const std::filesystem::path& path, const PointTable& table)
 
 namespace {
 
-constexpr const char* kLabelColumns[] = {"type",        "truncated",   "occluded",    "alpha",      "bbox left",
-                                         "bbox top",    "bbox right",  "bbox bottom", "height",     "width",
-                                         "length",      "location x",  "location y",  "location z", "rotation_y",
-                                         "score"};
+constexpr const char* kLabelColumns[] = {"type",       "truncated",   "occluded",   "alpha", "bbox left", "bbox top",
+                                         "bbox right", "bbox bottom", "height",     "width", "length",    "location x",
+                                         "location y", "location z",  "rotation_y", "score"};
 
 KittiObject parse_label_line(const std::vector<std::string_view>& tokens, std::size_t line, const std::string& source) {
   if (tokens.size() != 15 && tokens.size() != 16) {
     throw InputError(source, line_field(line),
                      "expected 15 values (type truncated occluded alpha bbox[4] dimensions[3] location[3] rotation_y) "
-                     "or 16 with a score, found " + std::to_string(tokens.size()));
+                     "or 16 with a score, found " +
+                         std::to_string(tokens.size()));
   }
   const auto number = [&](std::size_t column) {
-    return parse_finite(tokens[column], source, line_field(line) + " column " + std::to_string(column + 1) + " (" +
-                                                    kLabelColumns[column] + ")");
+    return parse_finite(tokens[column], source,
+                        line_field(line) + " column " + std::to_string(column + 1) + " (" + kLabelColumns[column] + ")");
   };
   KittiObject object;
   object.type = tokens[0];
   object.truncated = number(1);
-  const long long occluded =
-      parse_integer(tokens[2], source, line_field(line) + " column 3 (occluded)");
+  const long long occluded = parse_integer(tokens[2], source, line_field(line) + " column 3 (occluded)");
   if (occluded < -1 || occluded > 3) {
     throw InputError(source, line_field(line) + " column 3 (occluded)", "expected -1, 0, 1, 2 or 3, found " + std::to_string(occluded));
   }

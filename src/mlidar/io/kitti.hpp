@@ -25,15 +25,15 @@ void write_kitti_bin(const std::filesystem::path& path, const PointTable& table)
 
 /// One line of a KITTI label_2 file (camera frame, metres, radians).
 struct KittiObject {
-  std::string type;                 ///< Car, Pedestrian, Cyclist, DontCare, ...
+  std::string type;  ///< Car, Pedestrian, Cyclist, DontCare, ...
   double truncated = 0.0;
   int occluded = 0;
   double alpha = 0.0;
-  std::array<double, 4> bbox{};     ///< left top right bottom, pixels
+  std::array<double, 4> bbox{};         ///< left top right bottom, pixels
   Eigen::Vector3d dimensions{0, 0, 0};  ///< height width length
   Eigen::Vector3d location{0, 0, 0};    ///< bottom centre in the camera frame
   double rotation_y = 0.0;
-  std::optional<double> score;      ///< detections only
+  std::optional<double> score;  ///< detections only
 };
 
 std::vector<KittiObject> parse_kitti_labels(const std::string& text, const std::string& source);
@@ -42,7 +42,7 @@ void write_kitti_labels(const std::filesystem::path& path, const std::vector<Kit
 
 /// A KITTI calibration file: named matrices of 9 or 12 numbers.
 struct KittiCalib {
-  std::array<Eigen::Matrix<double, 3, 4>, 4> P{};        ///< P0..P3
+  std::array<Eigen::Matrix<double, 3, 4>, 4> P{};  ///< P0..P3
   Eigen::Matrix3d R0_rect = Eigen::Matrix3d::Identity();
   Eigen::Matrix<double, 3, 4> Tr_velo_to_cam = Eigen::Matrix<double, 3, 4>::Zero();
   std::optional<Eigen::Matrix<double, 3, 4>> Tr_imu_to_velo;

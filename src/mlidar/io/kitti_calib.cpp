@@ -43,8 +43,7 @@ CalibEntries parse_entries(const std::string& text, const std::string& source) {
 }
 
 template <int Rows, int Cols>
-Eigen::Matrix<double, Rows, Cols> matrix_entry(const CalibEntries& entries, const std::string& name,
-                                               const std::string& source) {
+Eigen::Matrix<double, Rows, Cols> matrix_entry(const CalibEntries& entries, const std::string& name, const std::string& source) {
   const auto found = entries.find(name);
   if (found == entries.end()) throw InputError(source, name, "missing (a KITTI calib file needs P0-P3, R0_rect and Tr_velo_to_cam)");
   const auto& values = found->second.values;
@@ -83,9 +82,7 @@ KittiCalib parse_kitti_calib(const std::string& text, const std::string& source)
   return calib;
 }
 
-KittiCalib read_kitti_calib(const std::filesystem::path& path) {
-  return parse_kitti_calib(read_file_text(path), path.string());
-}
+KittiCalib read_kitti_calib(const std::filesystem::path& path) { return parse_kitti_calib(read_file_text(path), path.string()); }
 
 void write_kitti_calib(const std::filesystem::path& path, const KittiCalib& calib) {
   std::string text;

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/io/rigid_check.hpp"
@@ -21,12 +22,7 @@ constexpr std::string_view kDeviceKey = "device_id:";
 constexpr std::string_view kPoseKey = "(Roll,Pitch,Yaw,tx,ty,tz):";
 
 // R = Rz(yaw) Ry(pitch) Rx(roll), angles in degrees.
-SE3 pose_from_rpy_degrees(const std::vector<double>& v) {
-  const double to_rad = std::numbers::pi / 180.0;
-  const Quat r = Eigen::AngleAxisd(v[2] * to_rad, Vec3::UnitZ()) * Eigen::AngleAxisd(v[1] * to_rad, Vec3::UnitY()) *
-                 Eigen::AngleAxisd(v[0] * to_rad, Vec3::UnitX());
-  return {r, Vec3(v[3], v[4], v[5])};
-}
+SE3 pose_from_rpy_degrees(const std::vector<double>& v) { return {quat_from_rpy_deg(Vec3(v[0], v[1], v[2])), Vec3(v[3], v[4], v[5])}; }
 
 std::string device_name(long long id, const std::vector<std::string>& names, const std::string& source, const std::string& field) {
   if (names.empty()) return "device_" + std::to_string(id);
@@ -51,7 +47,8 @@ std::map<int, std::filesystem::path> parse_opencalib_cloud_paths(const std::stri
       if (id >= 0) throw InputError(source, field, "device_id without a 'path:' line before it");
       const long long value = parse_integer(trim(content.substr(kDeviceKey.size())), source, field + " (device_id)");
       if (value < 0 || value > 1'000'000) throw InputError(source, field, "device_id must be in [0, 1000000]");
-      if (clouds.contains(static_cast<int>(value))) throw InputError(source, field, "device_id " + std::to_string(value) + " appears twice");
+      if (clouds.contains(static_cast<int>(value)))
+        throw InputError(source, field, "device_id " + std::to_string(value) + " appears twice");
       id = static_cast<int>(value);
     } else if (content.starts_with(kPathKey)) {
       if (id < 0) throw InputError(source, field, "path line without a device_id line before it");
@@ -71,8 +68,7 @@ std::map<int, std::filesystem::path> read_opencalib_cloud_paths(const std::files
   return parse_opencalib_cloud_paths(read_file_text(path), path.string(), path.parent_path());
 }
 
-Extrinsics parse_opencalib_initial_extrinsics(const std::string& text, const std::string& source,
-                                              const std::vector<std::string>& names) {
+Extrinsics parse_opencalib_initial_extrinsics(const std::string& text, const std::string& source, const std::vector<std::string>& names) {
   Extrinsics extrinsics;
   std::vector<long long> ids;
   bool awaiting_pose = false;
@@ -84,7 +80,8 @@ Extrinsics parse_opencalib_initial_extrinsics(const std::string& text, const std
       if (awaiting_pose) throw InputError(source, field, "device_id without a (Roll,Pitch,Yaw,tx,ty,tz) line before it");
       const long long id = parse_integer(trim(content.substr(kDeviceKey.size())), source, field + " (device_id)");
       if (id < 0) throw InputError(source, field, "device_id must be >= 0");
-      if (std::find(ids.begin(), ids.end(), id) != ids.end()) throw InputError(source, field, "device_id " + std::to_string(id) + " appears twice");
+      if (std::find(ids.begin(), ids.end(), id) != ids.end())
+        throw InputError(source, field, "device_id " + std::to_string(id) + " appears twice");
       ids.push_back(id);
       awaiting_pose = true;
     } else if (content.starts_with(kPoseKey)) {

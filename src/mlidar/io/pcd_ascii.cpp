@@ -16,7 +16,6 @@
 namespace mlidar::io::pcd_detail {
 namespace {
 
-
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
 // Next whitespace-separated word of `line` from `cursor`; empty at the end.
@@ -29,8 +28,7 @@ std::string_view next_word(std::string_view line, std::size_t& cursor) {
 
 class AsciiRowReader {
  public:
-  AsciiRowReader(const PcdHeader& header, const std::string& source, PointTable& table)
-      : header_(header), source_(source), table_(table) {}
+  AsciiRowReader(const PcdHeader& header, const std::string& source, PointTable& table) : header_(header), source_(source), table_(table) {}
 
   void read_row(std::string_view line, std::size_t row) {
     std::size_t cursor = 0;
@@ -42,9 +40,10 @@ class AsciiRowReader {
         const std::string_view word = next_word(line, cursor);
         if (word.empty()) fail_count(row, seen);
         if (!parse_scalar_token(word, column.type, out + e * size)) {
-          throw InputError(source_, "DATA", "row " + std::to_string(row + 1) + ": " + printable(word) + " for field " +
-                                                printable(column.name) + " is not a valid " + scalar_name(column.type) +
-                                                (is_float(column.type) ? "" : " (expected an integer in its range)"));
+          throw InputError(source_, "DATA",
+                           "row " + std::to_string(row + 1) + ": " + printable(word) + " for field " + printable(column.name) +
+                               " is not a valid " + scalar_name(column.type) +
+                               (is_float(column.type) ? "" : " (expected an integer in its range)"));
         }
       }
     }
@@ -53,9 +52,10 @@ class AsciiRowReader {
 
  private:
   [[noreturn]] void fail_count(std::size_t row, std::uint64_t found) const {
-    throw InputError(source_, "DATA", "row " + std::to_string(row + 1) + " has " + (found > header_.values_per_point ? "more than " : "") +
-                                          std::to_string(std::min(found, header_.values_per_point)) + " values (expected " +
-                                          std::to_string(header_.values_per_point) + " per row, from FIELDS and COUNT)");
+    throw InputError(source_, "DATA",
+                     "row " + std::to_string(row + 1) + " has " + (found > header_.values_per_point ? "more than " : "") +
+                         std::to_string(std::min(found, header_.values_per_point)) + " values (expected " +
+                         std::to_string(header_.values_per_point) + " per row, from FIELDS and COUNT)");
   }
 
   const PcdHeader& header_;
@@ -75,28 +75,37 @@ void append_number(const std::byte* in, std::vector<std::byte>& out) {
 
 void append_value(const std::byte* in, ScalarType type, std::vector<std::byte>& out) {
   switch (type) {
-    case ScalarType::kI8: return append_number<std::int8_t>(in, out);
-    case ScalarType::kU8: return append_number<std::uint8_t>(in, out);
-    case ScalarType::kI16: return append_number<std::int16_t>(in, out);
-    case ScalarType::kU16: return append_number<std::uint16_t>(in, out);
-    case ScalarType::kI32: return append_number<std::int32_t>(in, out);
-    case ScalarType::kU32: return append_number<std::uint32_t>(in, out);
-    case ScalarType::kI64: return append_number<std::int64_t>(in, out);
-    case ScalarType::kU64: return append_number<std::uint64_t>(in, out);
-    case ScalarType::kF32: return append_number<float>(in, out);
-    case ScalarType::kF64: return append_number<double>(in, out);
+    case ScalarType::kI8:
+      return append_number<std::int8_t>(in, out);
+    case ScalarType::kU8:
+      return append_number<std::uint8_t>(in, out);
+    case ScalarType::kI16:
+      return append_number<std::int16_t>(in, out);
+    case ScalarType::kU16:
+      return append_number<std::uint16_t>(in, out);
+    case ScalarType::kI32:
+      return append_number<std::int32_t>(in, out);
+    case ScalarType::kU32:
+      return append_number<std::uint32_t>(in, out);
+    case ScalarType::kI64:
+      return append_number<std::int64_t>(in, out);
+    case ScalarType::kU64:
+      return append_number<std::uint64_t>(in, out);
+    case ScalarType::kF32:
+      return append_number<float>(in, out);
+    case ScalarType::kF64:
+      return append_number<double>(in, out);
   }
 }
 
 }  // namespace
 
-void decode_ascii_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source,
-                       PointTable& table) {
+void decode_ascii_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source, PointTable& table) {
   // Every value takes at least one byte: refuse before allocating what the file cannot hold.
   if (header.points * header.values_per_point > body.size()) {
-    throw InputError(source, "DATA", "ascii data of " + std::to_string(body.size()) + " bytes cannot hold POINTS = " +
-                                         std::to_string(header.points) + " rows of " + std::to_string(header.values_per_point) +
-                                         " values (expected that many rows: file truncated?)");
+    throw InputError(source, "DATA",
+                     "ascii data of " + std::to_string(body.size()) + " bytes cannot hold POINTS = " + std::to_string(header.points) +
+                         " rows of " + std::to_string(header.values_per_point) + " values (expected that many rows: file truncated?)");
   }
   table = make_table(header);
   const std::string_view text(reinterpret_cast<const char*>(body.data()), body.size());
@@ -105,8 +114,9 @@ void decode_ascii_body(std::span<const std::byte> body, const PcdHeader& header,
   std::size_t row = 0;
   while (row < table.num_points) {
     if (pos >= text.size()) {
-      throw InputError(source, "DATA", "ascii data ends after " + std::to_string(row) + " rows but POINTS = " +
-                                           std::to_string(table.num_points) + " (expected one row per point: file truncated?)");
+      throw InputError(source, "DATA",
+                       "ascii data ends after " + std::to_string(row) + " rows but POINTS = " + std::to_string(table.num_points) +
+                           " (expected one row per point: file truncated?)");
     }
     const std::size_t newline = text.find('\n', pos);
     const std::size_t end = newline == std::string_view::npos ? text.size() : newline;

@@ -36,9 +36,9 @@ struct PcdHeader {
   std::uint64_t points = 0;
   std::array<double, 7> viewpoint{0, 0, 0, 1, 0, 0, 0};
   PcdEncoding encoding = PcdEncoding::kBinary;
-  std::uint64_t record_size = 0;          ///< bytes of one packed point (all fields)
-  std::uint64_t values_per_point = 0;     ///< sum of COUNT (ascii tokens per row)
-  std::size_t data_offset = 0;            ///< first byte after the DATA line
+  std::uint64_t record_size = 0;       ///< bytes of one packed point (all fields)
+  std::uint64_t values_per_point = 0;  ///< sum of COUNT (ascii tokens per row)
+  std::size_t data_offset = 0;         ///< first byte after the DATA line
 };
 
 /// Parses and validates the text header; every size it returns is free of overflow:
@@ -49,8 +49,7 @@ PcdHeader parse_pcd_header(std::span<const std::byte> bytes, const std::string& 
 PointTable make_table(const PcdHeader& header);
 
 /// DATA ascii: one row per point, whitespace-separated values (nan/inf allowed for F).
-void decode_ascii_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source,
-                       PointTable& table);
+void decode_ascii_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source, PointTable& table);
 void append_ascii_body(const PointTable& table, std::vector<std::byte>& out);
 
 /// Field names are words: non-empty, no spaces or control characters (UTF-8 is fine).
@@ -63,20 +62,25 @@ std::string printable(std::string_view text);
 /// to dst (one every dst_step bytes): packed records <-> columns. Fixed sizes
 /// let memcpy become a single load/store (measured ~9x faster than per record).
 template <std::size_t kSize>
-void strided_copy_fixed(const std::byte* src, std::size_t src_step, std::byte* dst, std::size_t dst_step,
-                        std::size_t count) {
+void strided_copy_fixed(const std::byte* src, std::size_t src_step, std::byte* dst, std::size_t dst_step, std::size_t count) {
   for (std::size_t i = 0; i < count; ++i) std::memcpy(dst + i * dst_step, src + i * src_step, kSize);
 }
 
-inline void strided_copy(const std::byte* src, std::size_t src_step, std::byte* dst, std::size_t dst_step,
-                         std::size_t size, std::size_t count) {
+inline void strided_copy(const std::byte* src, std::size_t src_step, std::byte* dst, std::size_t dst_step, std::size_t size,
+                         std::size_t count) {
   switch (size) {
-    case 1: return strided_copy_fixed<1>(src, src_step, dst, dst_step, count);
-    case 2: return strided_copy_fixed<2>(src, src_step, dst, dst_step, count);
-    case 4: return strided_copy_fixed<4>(src, src_step, dst, dst_step, count);
-    case 8: return strided_copy_fixed<8>(src, src_step, dst, dst_step, count);
-    case 12: return strided_copy_fixed<12>(src, src_step, dst, dst_step, count);
-    case 16: return strided_copy_fixed<16>(src, src_step, dst, dst_step, count);
+    case 1:
+      return strided_copy_fixed<1>(src, src_step, dst, dst_step, count);
+    case 2:
+      return strided_copy_fixed<2>(src, src_step, dst, dst_step, count);
+    case 4:
+      return strided_copy_fixed<4>(src, src_step, dst, dst_step, count);
+    case 8:
+      return strided_copy_fixed<8>(src, src_step, dst, dst_step, count);
+    case 12:
+      return strided_copy_fixed<12>(src, src_step, dst, dst_step, count);
+    case 16:
+      return strided_copy_fixed<16>(src, src_step, dst, dst_step, count);
     default:
       for (std::size_t i = 0; i < count; ++i) std::memcpy(dst + i * dst_step, src + i * src_step, size);
   }

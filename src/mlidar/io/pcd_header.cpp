@@ -13,8 +13,8 @@ namespace mlidar::io::pcd_detail {
 namespace {
 
 enum Keyword : std::size_t { kVersion, kFields, kSize, kType, kCount, kWidth, kHeight, kViewpoint, kPoints, kData, kNumKeywords };
-constexpr std::array<std::string_view, kNumKeywords> kKeywordNames = {
-    "VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+constexpr std::array<std::string_view, kNumKeywords> kKeywordNames = {"VERSION", "FIELDS", "SIZE",      "TYPE",   "COUNT",
+                                                                      "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
 
 using Tokens = std::vector<std::string_view>;
 
@@ -130,8 +130,8 @@ class HeaderParser {
 
   void check_per_field(Keyword keyword, std::size_t num_fields) const {
     if (values_[keyword].size() != num_fields) {
-      fail(keyword, "has " + std::to_string(values_[keyword].size()) + " values but FIELDS names " +
-                        std::to_string(num_fields) + " (expected one per field)");
+      fail(keyword, "has " + std::to_string(values_[keyword].size()) + " values but FIELDS names " + std::to_string(num_fields) +
+                        " (expected one per field)");
     }
   }
 
@@ -140,11 +140,20 @@ class HeaderParser {
     if (!integer && type != "F") fail(kType, printable(type) + " of field " + printable(name) + " is unknown (expected I, U or F)");
     const bool is_signed = type == "I";
     switch (size) {
-      case 1: if (integer) return is_signed ? ScalarType::kI8 : ScalarType::kU8; break;
-      case 2: if (integer) return is_signed ? ScalarType::kI16 : ScalarType::kU16; break;
-      case 4: if (integer) return is_signed ? ScalarType::kI32 : ScalarType::kU32; return ScalarType::kF32;
-      case 8: if (integer) return is_signed ? ScalarType::kI64 : ScalarType::kU64; return ScalarType::kF64;
-      default: break;
+      case 1:
+        if (integer) return is_signed ? ScalarType::kI8 : ScalarType::kU8;
+        break;
+      case 2:
+        if (integer) return is_signed ? ScalarType::kI16 : ScalarType::kU16;
+        break;
+      case 4:
+        if (integer) return is_signed ? ScalarType::kI32 : ScalarType::kU32;
+        return ScalarType::kF32;
+      case 8:
+        if (integer) return is_signed ? ScalarType::kI64 : ScalarType::kU64;
+        return ScalarType::kF64;
+      default:
+        break;
     }
     fail(kType, "TYPE " + std::string(type) + " with SIZE " + std::to_string(size) + " for field " + printable(name) +
                     " is not a valid pair (expected I or U with SIZE 1, 2, 4 or 8; F with SIZE 4 or 8)");
@@ -165,7 +174,8 @@ class HeaderParser {
       if (!field.is_padding() && !unique_names.insert(names[i]).second) {
         fail(kFields, "names " + printable(names[i]) + " twice (expected unique names; only the padding field _ may repeat)");
       }
-      field.type = scalar_type(values_[kType][i], parse_unsigned(kSize, values_[kSize][i], std::numeric_limits<std::uint32_t>::max()), field.name);
+      field.type =
+          scalar_type(values_[kType][i], parse_unsigned(kSize, values_[kSize][i], std::numeric_limits<std::uint32_t>::max()), field.name);
       if (seen_[kCount]) {
         const std::uint64_t count = parse_unsigned(kCount, values_[kCount][i], std::numeric_limits<std::uint32_t>::max());
         if (count == 0) fail(kCount, "of field " + printable(field.name) + " is 0 (expected a positive count)");
@@ -185,8 +195,8 @@ class HeaderParser {
     if (seen_[kPoints]) {
       const std::uint64_t points = parse_unsigned(kPoints, single(kPoints)[0], std::numeric_limits<std::uint64_t>::max());
       if (points != expected) {
-        fail(kPoints, "is " + std::to_string(points) + " but WIDTH x HEIGHT = " + std::to_string(expected) +
-                          " (expected POINTS = WIDTH * HEIGHT)");
+        fail(kPoints,
+             "is " + std::to_string(points) + " but WIDTH x HEIGHT = " + std::to_string(expected) + " (expected POINTS = WIDTH * HEIGHT)");
       }
     }
   }
@@ -208,10 +218,14 @@ class HeaderParser {
 
   void parse_data_kind() {
     const std::string_view kind = single(kData)[0];
-    if (kind == "ascii") header_.encoding = PcdEncoding::kAscii;
-    else if (kind == "binary") header_.encoding = PcdEncoding::kBinary;
-    else if (kind == "binary_compressed") header_.encoding = PcdEncoding::kBinaryCompressed;
-    else fail(kData, "kind " + printable(kind) + " is unknown (expected ascii, binary or binary_compressed)");
+    if (kind == "ascii")
+      header_.encoding = PcdEncoding::kAscii;
+    else if (kind == "binary")
+      header_.encoding = PcdEncoding::kBinary;
+    else if (kind == "binary_compressed")
+      header_.encoding = PcdEncoding::kBinaryCompressed;
+    else
+      fail(kData, "kind " + printable(kind) + " is unknown (expected ascii, binary or binary_compressed)");
   }
 
   // Sizes used to bound reads and allocations; all products checked for overflow.
@@ -260,9 +274,7 @@ std::string printable(std::string_view text) {
   return out + "'";
 }
 
-PcdHeader parse_pcd_header(std::span<const std::byte> bytes, const std::string& source) {
-  return HeaderParser(bytes, source).parse();
-}
+PcdHeader parse_pcd_header(std::span<const std::byte> bytes, const std::string& source) { return HeaderParser(bytes, source).parse(); }
 
 PointTable make_table(const PcdHeader& header) {
   PointTable table;

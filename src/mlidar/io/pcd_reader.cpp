@@ -23,13 +23,12 @@ static_assert(std::endian::native == std::endian::little, "PCD binary data is re
 // block of C compressed bytes decodes to at most 88 * C bytes.
 constexpr std::uint64_t kLzfMaxExpansion = 88;
 
-
-void decode_binary_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source,
-                        PointTable& table) {
+void decode_binary_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source, PointTable& table) {
   const std::uint64_t needed = header.points * header.record_size;  // overflow-checked by the header parser
   if (body.size() < needed) {
-    throw InputError(source, "DATA", "binary data holds " + std::to_string(body.size()) + " bytes but POINTS x record size = " +
-                                         std::to_string(needed) + " (expected that many bytes: file truncated?)");
+    throw InputError(source, "DATA",
+                     "binary data holds " + std::to_string(body.size()) + " bytes but POINTS x record size = " + std::to_string(needed) +
+                         " (expected that many bytes: file truncated?)");
   }
   table = pcd_detail::make_table(header);
   std::size_t offset = 0;
@@ -49,17 +48,18 @@ std::uint32_t load_u32(const std::byte* bytes) {
 // binary_compressed: uint32 compressed size, uint32 uncompressed size, LZF block.
 // The block holds each field's column in turn. PCL leaves padding fields (_)
 // out of the block; both layouts are accepted, told apart by the uncompressed size.
-void decode_compressed_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source,
-                            PointTable& table) {
+void decode_compressed_body(std::span<const std::byte> body, const PcdHeader& header, const std::string& source, PointTable& table) {
   if (body.size() < 8) {
-    throw InputError(source, "DATA", "binary_compressed data is " + std::to_string(body.size()) +
-                                         " bytes (expected at least the 8-byte compressed/uncompressed size prefix)");
+    throw InputError(source, "DATA",
+                     "binary_compressed data is " + std::to_string(body.size()) +
+                         " bytes (expected at least the 8-byte compressed/uncompressed size prefix)");
   }
   const std::uint64_t compressed_size = load_u32(body.data());
   const std::uint64_t uncompressed_size = load_u32(body.data() + 4);
   if (compressed_size > body.size() - 8) {
-    throw InputError(source, "DATA", "compressed size " + std::to_string(compressed_size) + " exceeds the " +
-                                         std::to_string(body.size() - 8) + " bytes left in the file (file truncated?)");
+    throw InputError(source, "DATA",
+                     "compressed size " + std::to_string(compressed_size) + " exceeds the " + std::to_string(body.size() - 8) +
+                         " bytes left in the file (file truncated?)");
   }
   std::uint64_t padding_stride = 0;
   for (const auto& field : header.fields) padding_stride += field.is_padding() ? field.stride() : 0;
@@ -67,20 +67,23 @@ void decode_compressed_body(std::span<const std::byte> body, const PcdHeader& he
   const std::uint64_t unpadded_size = header.points * (header.record_size - padding_stride);
   const bool has_padding_columns = uncompressed_size == full_size;
   if (!has_padding_columns && uncompressed_size != unpadded_size) {
-    throw InputError(source, "DATA", "uncompressed size " + std::to_string(uncompressed_size) + " but POINTS x record size = " +
-                                         std::to_string(full_size) + " (expected them equal)");
+    throw InputError(source, "DATA",
+                     "uncompressed size " + std::to_string(uncompressed_size) + " but POINTS x record size = " + std::to_string(full_size) +
+                         " (expected them equal)");
   }
   if (uncompressed_size > kLzfMaxExpansion * compressed_size) {
-    throw InputError(source, "DATA", "uncompressed size " + std::to_string(uncompressed_size) + " cannot come from " +
-                                         std::to_string(compressed_size) + " LZF bytes (expected at most 88x expansion)");
+    throw InputError(source, "DATA",
+                     "uncompressed size " + std::to_string(uncompressed_size) + " cannot come from " + std::to_string(compressed_size) +
+                         " LZF bytes (expected at most 88x expansion)");
   }
   const auto decoded = std::make_unique_for_overwrite<std::byte[]>(uncompressed_size);
   if (uncompressed_size > 0) {
     const unsigned int produced = lzf_decompress(body.data() + 8, static_cast<unsigned int>(compressed_size), decoded.get(),
                                                  static_cast<unsigned int>(uncompressed_size));
     if (produced != uncompressed_size) {
-      throw InputError(source, "DATA", "LZF block is corrupt (decoded " + std::to_string(produced) + " of " +
-                                           std::to_string(uncompressed_size) + " bytes)");
+      throw InputError(
+          source, "DATA",
+          "LZF block is corrupt (decoded " + std::to_string(produced) + " of " + std::to_string(uncompressed_size) + " bytes)");
     }
   }
   table = pcd_detail::make_table(header);
@@ -130,9 +133,15 @@ PcdCloud parse_pcd(std::span<const std::byte> bytes, const std::string& source, 
   cloud.viewpoint = header.viewpoint;
   const auto body = bytes.subspan(header.data_offset);
   switch (header.encoding) {
-    case PcdEncoding::kAscii: pcd_detail::decode_ascii_body(body, header, source, cloud.table); break;
-    case PcdEncoding::kBinary: decode_binary_body(body, header, source, cloud.table); break;
-    case PcdEncoding::kBinaryCompressed: decode_compressed_body(body, header, source, cloud.table); break;
+    case PcdEncoding::kAscii:
+      pcd_detail::decode_ascii_body(body, header, source, cloud.table);
+      break;
+    case PcdEncoding::kBinary:
+      decode_binary_body(body, header, source, cloud.table);
+      break;
+    case PcdEncoding::kBinaryCompressed:
+      decode_compressed_body(body, header, source, cloud.table);
+      break;
   }
   if (options.drop_nan) drop_non_finite_points(cloud.table);
   return cloud;

@@ -65,8 +65,10 @@ const char* type_letter(ScalarType type) {
     case ScalarType::kI8:
     case ScalarType::kI16:
     case ScalarType::kI32:
-    case ScalarType::kI64: return "I";
-    default: return "U";
+    case ScalarType::kI64:
+      return "I";
+    default:
+      return "U";
   }
 }
 
@@ -92,7 +94,6 @@ std::string format_header(const PcdCloud& cloud, std::uint32_t width, std::uint3
   out.append("\nDATA ").append(pcd_encoding_name(cloud.encoding)).append("\n");
   return out;
 }
-
 
 void append_binary_body(const PointTable& table, std::vector<std::byte>& out) {
   std::size_t record_size = 0;
@@ -135,9 +136,12 @@ void append_compressed_body(const PointTable& table, std::vector<std::byte>& out
 
 const char* pcd_encoding_name(PcdEncoding encoding) {
   switch (encoding) {
-    case PcdEncoding::kAscii: return "ascii";
-    case PcdEncoding::kBinary: return "binary";
-    case PcdEncoding::kBinaryCompressed: return "binary_compressed";
+    case PcdEncoding::kAscii:
+      return "ascii";
+    case PcdEncoding::kBinary:
+      return "binary";
+    case PcdEncoding::kBinaryCompressed:
+      return "binary_compressed";
   }
   return "?";
 }
@@ -152,9 +156,15 @@ std::vector<std::byte> encode_pcd(const PcdCloud& cloud) {
   const auto* header_bytes = reinterpret_cast<const std::byte*>(header.data());
   out.insert(out.end(), header_bytes, header_bytes + header.size());
   switch (cloud.encoding) {
-    case PcdEncoding::kAscii: pcd_detail::append_ascii_body(cloud.table, out); break;
-    case PcdEncoding::kBinary: append_binary_body(cloud.table, out); break;
-    case PcdEncoding::kBinaryCompressed: append_compressed_body(cloud.table, out); break;
+    case PcdEncoding::kAscii:
+      pcd_detail::append_ascii_body(cloud.table, out);
+      break;
+    case PcdEncoding::kBinary:
+      append_binary_body(cloud.table, out);
+      break;
+    case PcdEncoding::kBinaryCompressed:
+      append_compressed_body(cloud.table, out);
+      break;
   }
   return out;
 }

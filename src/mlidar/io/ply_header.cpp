@@ -15,12 +15,10 @@ struct TypeSpelling {
 };
 
 constexpr TypeSpelling kTypeSpellings[] = {
-    {"char", ScalarType::kI8},     {"int8", ScalarType::kI8},      {"uchar", ScalarType::kU8},
-    {"uint8", ScalarType::kU8},    {"short", ScalarType::kI16},    {"int16", ScalarType::kI16},
-    {"ushort", ScalarType::kU16},  {"uint16", ScalarType::kU16},   {"int", ScalarType::kI32},
-    {"int32", ScalarType::kI32},   {"uint", ScalarType::kU32},     {"uint32", ScalarType::kU32},
-    {"float", ScalarType::kF32},   {"float32", ScalarType::kF32},  {"double", ScalarType::kF64},
-    {"float64", ScalarType::kF64},
+    {"char", ScalarType::kI8},   {"int8", ScalarType::kI8},     {"uchar", ScalarType::kU8},   {"uint8", ScalarType::kU8},
+    {"short", ScalarType::kI16}, {"int16", ScalarType::kI16},   {"ushort", ScalarType::kU16}, {"uint16", ScalarType::kU16},
+    {"int", ScalarType::kI32},   {"int32", ScalarType::kI32},   {"uint", ScalarType::kU32},   {"uint32", ScalarType::kU32},
+    {"float", ScalarType::kF32}, {"float32", ScalarType::kF32}, {"double", ScalarType::kF64}, {"float64", ScalarType::kF64},
 };
 
 constexpr const char* kTypeList = "char uchar short ushort int uint float double (or int8 ... float64)";
@@ -46,15 +44,13 @@ ScalarType type_or_throw(std::string_view name, const std::string& source, const
   throw InputError(source, field, "unknown property type '" + std::string(name) + "' (expected one of " + kTypeList + ")");
 }
 
-PlyEncoding encoding_or_throw(const std::vector<std::string_view>& tokens, const std::string& source,
-                              const std::string& field) {
+PlyEncoding encoding_or_throw(const std::vector<std::string_view>& tokens, const std::string& source, const std::string& field) {
   if (tokens.size() != 3) throw InputError(source, field, "expected 'format <encoding> 1.0'");
   for (const auto encoding : {PlyEncoding::kAscii, PlyEncoding::kBinaryLittleEndian, PlyEncoding::kBinaryBigEndian}) {
     if (tokens[1] == ply_encoding_name(encoding)) return encoding;
   }
   throw InputError(source, field,
-                   "unknown format '" + std::string(tokens[1]) +
-                       "' (expected ascii, binary_little_endian or binary_big_endian)");
+                   "unknown format '" + std::string(tokens[1]) + "' (expected ascii, binary_little_endian or binary_big_endian)");
 }
 
 std::uint64_t element_count_or_throw(std::string_view token, const std::string& source, const std::string& field) {
@@ -66,8 +62,7 @@ std::uint64_t element_count_or_throw(std::string_view token, const std::string& 
   return count;
 }
 
-PlyProperty property_or_throw(const std::vector<std::string_view>& tokens, const std::string& source,
-                              const std::string& field) {
+PlyProperty property_or_throw(const std::vector<std::string_view>& tokens, const std::string& source, const std::string& field) {
   PlyProperty property;
   if (tokens.size() == 5 && tokens[1] == "list") {
     property.is_list = true;

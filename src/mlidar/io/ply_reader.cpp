@@ -24,9 +24,7 @@ struct Where {
   const PlyElement& element;
   std::uint64_t row;
   const PlyProperty& property;
-  std::string str() const {
-    return "element " + element.name + " row " + std::to_string(row) + " property " + property.name;
-  }
+  std::string str() const { return "element " + element.name + " row " + std::to_string(row) + " property " + property.name; }
 };
 
 // Minimum bytes (binary) or tokens (ascii) one row takes: a list takes at least its count.
@@ -43,8 +41,8 @@ void check_count_fits(const PlyElement& element, std::size_t remaining, bool bin
   const std::size_t capacity = per_row == 0 ? 0 : binary ? remaining / per_row : (remaining + 1) / (2 * per_row);
   if (per_row != 0 && element.count > capacity) {
     throw InputError(source, "element " + element.name,
-                     "promises " + std::to_string(element.count) + " rows but the data holds at most " +
-                         std::to_string(capacity) + " (file truncated or count wrong)");
+                     "promises " + std::to_string(element.count) + " rows but the data holds at most " + std::to_string(capacity) +
+                         " (file truncated or count wrong)");
   }
 }
 
@@ -69,21 +67,27 @@ std::int64_t load_count(ScalarType type, const std::byte* raw) {
     return static_cast<std::int64_t>(value);
   };
   switch (type) {
-    case ScalarType::kI8: return load(std::int8_t{});
-    case ScalarType::kU8: return load(std::uint8_t{});
-    case ScalarType::kI16: return load(std::int16_t{});
-    case ScalarType::kU16: return load(std::uint16_t{});
-    case ScalarType::kI32: return load(std::int32_t{});
-    case ScalarType::kU32: return load(std::uint32_t{});
-    default: return -1;  // the header admits only 8-32 bit integer count types
+    case ScalarType::kI8:
+      return load(std::int8_t{});
+    case ScalarType::kU8:
+      return load(std::uint8_t{});
+    case ScalarType::kI16:
+      return load(std::int16_t{});
+    case ScalarType::kU16:
+      return load(std::uint16_t{});
+    case ScalarType::kI32:
+      return load(std::int32_t{});
+    case ScalarType::kU32:
+      return load(std::uint32_t{});
+    default:
+      return -1;  // the header admits only 8-32 bit integer count types
   }
 }
 
 class BinaryBody {
  public:
   static constexpr bool kBinary = true;
-  BinaryBody(std::span<const std::byte> body, bool swap, const std::string& source)
-      : body_(body), swap_(swap), source_(source) {}
+  BinaryBody(std::span<const std::byte> body, bool swap, const std::string& source) : body_(body), swap_(swap), source_(source) {}
 
   std::size_t remaining() const { return body_.size() - pos_; }
   std::size_t max_items(ScalarType type) const { return remaining() / scalar_size(type); }
@@ -188,9 +192,12 @@ PointTable read_elements(const PlyHeader& header, Body& body, const std::string&
 
 const char* ply_encoding_name(PlyEncoding encoding) {
   switch (encoding) {
-    case PlyEncoding::kAscii: return "ascii";
-    case PlyEncoding::kBinaryLittleEndian: return "binary_little_endian";
-    case PlyEncoding::kBinaryBigEndian: return "binary_big_endian";
+    case PlyEncoding::kAscii:
+      return "ascii";
+    case PlyEncoding::kBinaryLittleEndian:
+      return "binary_little_endian";
+    case PlyEncoding::kBinaryBigEndian:
+      return "binary_big_endian";
   }
   return "?";
 }

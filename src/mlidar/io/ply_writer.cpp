@@ -36,7 +36,8 @@ FieldColumn as_ply_column(const FieldColumn& column, std::size_t num_points) {
   for (std::size_t i = 0; i < num_points; ++i) {
     for (std::uint32_t k = 0; k < column.count; ++k) {
       if (integer_magnitude(column, i, k) > kExactLimit) {
-        throw OutputError("PLY: column " + column.name + " holds a 64-bit integer beyond 2^53, which PLY cannot store "
+        throw OutputError("PLY: column " + column.name +
+                          " holds a 64-bit integer beyond 2^53, which PLY cannot store "
                           "exactly (PLY has no 64-bit integer type)");
       }
       const double value = column.value(i, k);

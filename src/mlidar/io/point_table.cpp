@@ -13,31 +13,45 @@ namespace mlidar::io {
 std::size_t scalar_size(ScalarType type) {
   switch (type) {
     case ScalarType::kI8:
-    case ScalarType::kU8: return 1;
+    case ScalarType::kU8:
+      return 1;
     case ScalarType::kI16:
-    case ScalarType::kU16: return 2;
+    case ScalarType::kU16:
+      return 2;
     case ScalarType::kI32:
     case ScalarType::kU32:
-    case ScalarType::kF32: return 4;
+    case ScalarType::kF32:
+      return 4;
     case ScalarType::kI64:
     case ScalarType::kU64:
-    case ScalarType::kF64: return 8;
+    case ScalarType::kF64:
+      return 8;
   }
   return 0;
 }
 
 const char* scalar_name(ScalarType type) {
   switch (type) {
-    case ScalarType::kI8: return "int8";
-    case ScalarType::kU8: return "uint8";
-    case ScalarType::kI16: return "int16";
-    case ScalarType::kU16: return "uint16";
-    case ScalarType::kI32: return "int32";
-    case ScalarType::kU32: return "uint32";
-    case ScalarType::kI64: return "int64";
-    case ScalarType::kU64: return "uint64";
-    case ScalarType::kF32: return "float32";
-    case ScalarType::kF64: return "float64";
+    case ScalarType::kI8:
+      return "int8";
+    case ScalarType::kU8:
+      return "uint8";
+    case ScalarType::kI16:
+      return "int16";
+    case ScalarType::kU16:
+      return "uint16";
+    case ScalarType::kI32:
+      return "int32";
+    case ScalarType::kU32:
+      return "uint32";
+    case ScalarType::kI64:
+      return "int64";
+    case ScalarType::kU64:
+      return "uint64";
+    case ScalarType::kF32:
+      return "float32";
+    case ScalarType::kF64:
+      return "float64";
   }
   return "?";
 }
@@ -56,16 +70,26 @@ double load(const std::byte* p) {
 double FieldColumn::value(std::size_t point, std::uint32_t element) const {
   const std::byte* p = data.data() + point * stride() + element * scalar_size(type);
   switch (type) {
-    case ScalarType::kI8: return load<std::int8_t>(p);
-    case ScalarType::kU8: return load<std::uint8_t>(p);
-    case ScalarType::kI16: return load<std::int16_t>(p);
-    case ScalarType::kU16: return load<std::uint16_t>(p);
-    case ScalarType::kI32: return load<std::int32_t>(p);
-    case ScalarType::kU32: return load<std::uint32_t>(p);
-    case ScalarType::kI64: return load<std::int64_t>(p);
-    case ScalarType::kU64: return load<std::uint64_t>(p);
-    case ScalarType::kF32: return load<float>(p);
-    case ScalarType::kF64: return load<double>(p);
+    case ScalarType::kI8:
+      return load<std::int8_t>(p);
+    case ScalarType::kU8:
+      return load<std::uint8_t>(p);
+    case ScalarType::kI16:
+      return load<std::int16_t>(p);
+    case ScalarType::kU16:
+      return load<std::uint16_t>(p);
+    case ScalarType::kI32:
+      return load<std::int32_t>(p);
+    case ScalarType::kU32:
+      return load<std::uint32_t>(p);
+    case ScalarType::kI64:
+      return load<std::int64_t>(p);
+    case ScalarType::kU64:
+      return load<std::uint64_t>(p);
+    case ScalarType::kF32:
+      return load<float>(p);
+    case ScalarType::kF64:
+      return load<double>(p);
   }
   return 0.0;
 }
@@ -77,9 +101,7 @@ const FieldColumn* PointTable::find(const std::string& name) const {
   return nullptr;
 }
 
-FieldColumn* PointTable::find(const std::string& name) {
-  return const_cast<FieldColumn*>(std::as_const(*this).find(name));
-}
+FieldColumn* PointTable::find(const std::string& name) { return const_cast<FieldColumn*>(std::as_const(*this).find(name)); }
 
 FieldColumn& PointTable::add_field(const std::string& name, ScalarType type, std::uint32_t count) {
   FieldColumn column;
@@ -102,25 +124,53 @@ const FieldColumn* find_first(const PointTable& table, const auto& names) {
 
 double unit_scale(TimeUnit unit) {
   switch (unit) {
-    case TimeUnit::kMilliseconds: return 1e-3;
-    case TimeUnit::kMicroseconds: return 1e-6;
-    case TimeUnit::kNanoseconds: return 1e-9;
-    default: return 1.0;
+    case TimeUnit::kMilliseconds:
+      return 1e-3;
+    case TimeUnit::kMicroseconds:
+      return 1e-6;
+    case TimeUnit::kNanoseconds:
+      return 1e-9;
+    default:
+      return 1.0;
   }
 }
 
-// Sweeps last well under a second, so the span of the raw values tells the
-// unit; absolute unix times are recognised by their magnitude.
-TimeUnit detect_time_unit(double min_value, double max_value) {
-  const double span = max_value - min_value;
-  const double magnitude = std::max(std::abs(min_value), std::abs(max_value));
-  if (span > 1e6 || (span == 0.0 && magnitude > 1e17)) return TimeUnit::kNanoseconds;
-  if (span > 1e3 || (span == 0.0 && magnitude > 1e14)) return TimeUnit::kMicroseconds;
-  if (span > 2.0 || (span == 0.0 && magnitude > 1e11)) return TimeUnit::kMilliseconds;
-  return TimeUnit::kSeconds;
+}  // namespace
+
+std::optional<TimeUnit> parse_time_unit(const std::string& text) {
+  for (const TimeUnit unit :
+       {TimeUnit::kAuto, TimeUnit::kSeconds, TimeUnit::kMilliseconds, TimeUnit::kMicroseconds, TimeUnit::kNanoseconds})
+    if (text == time_unit_name(unit)) return unit;
+  return std::nullopt;
 }
 
-}  // namespace
+const char* time_unit_name(TimeUnit unit) {
+  switch (unit) {
+    case TimeUnit::kAuto:
+      return "auto";
+    case TimeUnit::kSeconds:
+      return "s";
+    case TimeUnit::kMilliseconds:
+      return "ms";
+    case TimeUnit::kMicroseconds:
+      return "us";
+    case TimeUnit::kNanoseconds:
+      return "ns";
+  }
+  return "?";
+}
+
+const FieldColumn* find_time_field(const PointTable& table) { return find_first(table, kTimeFieldNames); }
+
+TimeUnit time_unit_of(const FieldColumn& field, TimeUnit requested, const std::string& source) {
+  if (requested != TimeUnit::kAuto) return requested;
+  if (is_float(field.type)) return TimeUnit::kSeconds;
+  if (scalar_size(field.type) >= 4) return TimeUnit::kNanoseconds;
+  throw InputError(source, "field " + field.name,
+                   std::string("is ") + scalar_name(field.type) +
+                       ", which cannot hold a per-point time (expected float seconds or 32/64-bit integer nanoseconds; "
+                       "set the LiDAR's time_unit in dataset.yaml if the unit differs)");
+}
 
 Scan to_scan(const PointTable& table, const std::string& source, const ScanOptions& options) {
   const FieldColumn* fx = table.find("x");
@@ -131,7 +181,8 @@ Scan to_scan(const PointTable& table, const std::string& source, const ScanOptio
   }
   const FieldColumn* fi = find_first(table, kIntensityFieldNames);
   const FieldColumn* fr = find_first(table, kRingFieldNames);
-  const FieldColumn* ft = find_first(table, kTimeFieldNames);
+  const FieldColumn* ft = options.read_time ? find_time_field(table) : nullptr;
+  const double scale = ft != nullptr ? unit_scale(time_unit_of(*ft, options.time_unit, source)) : 1.0;
 
   Scan scan;
   scan.points.reserve(table.num_points);
@@ -146,14 +197,12 @@ Scan to_scan(const PointTable& table, const std::string& source, const ScanOptio
   }
   if (!raw_time.empty()) {
     const auto [lo, hi] = std::minmax_element(raw_time.begin(), raw_time.end());
-    const TimeUnit unit = options.time_unit == TimeUnit::kAuto ? detect_time_unit(*lo, *hi) : options.time_unit;
-    const double scale = unit_scale(unit);
-    const double start = *lo;
-    if (!std::isfinite(start) || !std::isfinite(*hi)) {
-      throw InputError(source, "field " + ft->name, "holds non-finite times");
+    if (!std::isfinite(*lo) || !std::isfinite(*hi) ||
+        std::any_of(raw_time.begin(), raw_time.end(), [](double t) { return std::isnan(t); })) {
+      throw InputError(source, "field " + ft->name, "holds non-finite times (NaN or infinite)");
     }
-    // A start far from zero means the field held absolute times: keep it as the stamp.
-    if (std::abs(start * scale) > 1e6) scan.stamp = start * scale;
+    const double start = *lo;
+    scan.stamp = start * scale;
     scan.time.reserve(raw_time.size());
     for (double t : raw_time) scan.time.push_back(static_cast<float>((t - start) * scale));
   }

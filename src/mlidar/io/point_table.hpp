@@ -35,7 +35,7 @@ struct FieldColumn {
 
 struct PointTable {
   std::size_t num_points = 0;
-  std::uint32_t width = 0;   ///< organised clouds: width x height == num_points
+  std::uint32_t width = 0;  ///< organised clouds: width x height == num_points
   std::uint32_t height = 1;
   std::vector<FieldColumn> fields;
 
@@ -48,9 +48,14 @@ struct PointTable {
 /// Units of a per-point time field.
 enum class TimeUnit : std::uint8_t { kAuto, kSeconds, kMilliseconds, kMicroseconds, kNanoseconds };
 
+/// "s", "ms", "us", "ns" (and "auto"); nullopt for anything else.
+std::optional<TimeUnit> parse_time_unit(const std::string& text);
+const char* time_unit_name(TimeUnit unit);
+
 struct ScanOptions {
-  bool drop_nan = true;               ///< drop points whose x, y or z is not finite
+  bool drop_nan = true;  ///< drop points whose x, y or z is not finite
   TimeUnit time_unit = TimeUnit::kAuto;
+  bool read_time = true;  ///< false: ignore the time field (no Scan::time)
 };
 
 /// Names looked up for the time and ring channels, in order of preference.
@@ -58,12 +63,22 @@ inline constexpr const char* kTimeFieldNames[] = {"t", "time", "timestamp", "off
 inline constexpr const char* kRingFieldNames[] = {"ring", "laser_id"};
 inline constexpr const char* kIntensityFieldNames[] = {"intensity", "reflectance", "scalar_intensity", "i"};
 
+/// The time field of `table` (the first of kTimeFieldNames present), or null.
+const FieldColumn* find_time_field(const PointTable& table);
+
+/// The unit a time field is read in: `requested` unless kAuto, else from the
+/// field's type (floating point: seconds, as Velodyne's `time` and Hesai's
+/// `timestamp`; 32/64-bit integers: nanoseconds, as Ouster's `t` and Livox's
+/// `offset_time`). InputError naming `source` and the field for 8/16-bit
+/// integers, which cannot hold a time.
+TimeUnit time_unit_of(const FieldColumn& field, TimeUnit requested, const std::string& source);
+
 /// Builds a Scan: x y z required (InputError naming `source` otherwise),
-/// intensity, ring and time mapped when present. Times become seconds
-/// relative to the earliest point; units are detected from their span when
-/// options.time_unit is kAuto (span > 1e6 -> ns, > 1e3 -> us, else seconds
-/// unless absolute unix seconds). Scan::stamp takes the absolute start when
-/// the field held absolute times.
+/// intensity, ring and time mapped when present. With a time field (and
+/// options.read_time), Scan::stamp is the earliest point's time in seconds as
+/// the field holds it (absolute or relative; the frame source puts it on the
+/// frames' clock, io/frame_source.hpp) and Scan::time[i] >= 0 counts from it;
+/// without one, stamp is 0 and time empty. Non-finite times are InputError.
 Scan to_scan(const PointTable& table, const std::string& source, const ScanOptions& options = {});
 
 /// Inverse of to_scan: fields x y z (float32), intensity (float32), ring (uint16), t (float64 seconds).

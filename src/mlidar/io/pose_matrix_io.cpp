@@ -17,8 +17,7 @@ SE3 checked_rigid(const Mat4& matrix, const std::string& source, const std::stri
   if (!(error <= tolerance) || r.determinant() <= 0.0) {
     throw InputError(source, field,
                      "rotation block is not a rotation (max |R^T R - I| = " + exact_number(error) + ", det = " +
-                         exact_number(r.determinant()) + "; expected within " + exact_number(tolerance) +
-                         " of orthonormal with det +1)");
+                         exact_number(r.determinant()) + "; expected within " + exact_number(tolerance) + " of orthonormal with det +1)");
   }
   // Orthonormality was checked above against this reader's tolerance; only project here.
   return SE3::from_matrix(matrix, std::numeric_limits<double>::infinity());
@@ -82,8 +81,6 @@ SE3 parse_matrix_transform(const std::string& text, const std::string& source) {
   return checked_rigid(m, source, "matrix");
 }
 
-SE3 read_matrix_transform(const std::filesystem::path& path) {
-  return parse_matrix_transform(read_file_text(path), path.string());
-}
+SE3 read_matrix_transform(const std::filesystem::path& path) { return parse_matrix_transform(read_file_text(path), path.string()); }
 
 }  // namespace mlidar::io

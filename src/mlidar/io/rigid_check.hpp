@@ -13,7 +13,6 @@ inline constexpr double kMaxOrthonormalityError = 1e-3;
 /// SE3::from_matrix (re-orthonormalised) after checking that the rotation is
 /// within `tolerance` of orthonormal with determinant +1;
 /// InputError naming `source` and `field` otherwise.
-SE3 checked_rigid(const Mat4& matrix, const std::string& source, const std::string& field,
-                  double tolerance = kMaxOrthonormalityError);
+SE3 checked_rigid(const Mat4& matrix, const std::string& source, const std::string& field, double tolerance = kMaxOrthonormalityError);
 
 }  // namespace mlidar::io

@@ -135,16 +135,26 @@ bool parse_into(std::string_view word, std::byte* out) {
 
 bool parse_scalar_token(std::string_view word, ScalarType type, std::byte* out) {
   switch (type) {
-    case ScalarType::kI8: return parse_into<std::int8_t>(word, out);
-    case ScalarType::kU8: return parse_into<std::uint8_t>(word, out);
-    case ScalarType::kI16: return parse_into<std::int16_t>(word, out);
-    case ScalarType::kU16: return parse_into<std::uint16_t>(word, out);
-    case ScalarType::kI32: return parse_into<std::int32_t>(word, out);
-    case ScalarType::kU32: return parse_into<std::uint32_t>(word, out);
-    case ScalarType::kI64: return parse_into<std::int64_t>(word, out);
-    case ScalarType::kU64: return parse_into<std::uint64_t>(word, out);
-    case ScalarType::kF32: return parse_into<float>(word, out);
-    case ScalarType::kF64: return parse_into<double>(word, out);
+    case ScalarType::kI8:
+      return parse_into<std::int8_t>(word, out);
+    case ScalarType::kU8:
+      return parse_into<std::uint8_t>(word, out);
+    case ScalarType::kI16:
+      return parse_into<std::int16_t>(word, out);
+    case ScalarType::kU16:
+      return parse_into<std::uint16_t>(word, out);
+    case ScalarType::kI32:
+      return parse_into<std::int32_t>(word, out);
+    case ScalarType::kU32:
+      return parse_into<std::uint32_t>(word, out);
+    case ScalarType::kI64:
+      return parse_into<std::int64_t>(word, out);
+    case ScalarType::kU64:
+      return parse_into<std::uint64_t>(word, out);
+    case ScalarType::kF32:
+      return parse_into<float>(word, out);
+    case ScalarType::kF64:
+      return parse_into<double>(word, out);
   }
   return false;
 }

@@ -19,8 +19,8 @@ constexpr double kQuaternionNormTolerance = 1e-3;
 void check_increasing(double stamp, const Trajectory& trajectory, const std::string& source, const std::string& field) {
   if (!trajectory.empty() && !(stamp > trajectory.poses.back().stamp)) {
     throw InputError(source, field,
-                     "stamp " + exact_number(stamp) + " is not after the previous pose's " +
-                         exact_number(trajectory.poses.back().stamp) + " (stamps must increase)");
+                     "stamp " + exact_number(stamp) + " is not after the previous pose's " + exact_number(trajectory.poses.back().stamp) +
+                         " (stamps must increase)");
   }
 }
 
@@ -88,8 +88,9 @@ Trajectory parse_kitti_poses(const std::string& text, const std::string& source,
     trajectory.poses.push_back({stamp, checked_rigid(m, source, field)});
   }
   if (!stamps.empty() && trajectory.size() != stamps.size()) {
-    throw InputError(source, "poses", std::to_string(trajectory.size()) + " poses but " + std::to_string(stamps.size()) +
-                                          " stamps were given (one stamp per pose line)");
+    throw InputError(
+        source, "poses",
+        std::to_string(trajectory.size()) + " poses but " + std::to_string(stamps.size()) + " stamps were given (one stamp per pose line)");
   }
   return trajectory;
 }

@@ -16,7 +16,8 @@ class YamlFields {
   /// an unknown key is checked against (e.g. "dataset.yaml").
   YamlFields(std::string source, std::string schema);
 
-  /// Parses `text`; a syntax error fails with key "(document)".
+  /// Parses `text`; a syntax error fails with key "(document)", a key given
+  /// twice in one mapping (anywhere in the document) with its key path.
   YAML::Node load(const std::string& text) const;
 
   [[noreturn]] void fail(const std::string& key, const std::string& problem) const;

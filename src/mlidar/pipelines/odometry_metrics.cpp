@@ -1,6 +1,7 @@
 #include "mlidar/pipelines/odometry_metrics.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "mlidar/io/cloud_file.hpp"
 
@@ -19,7 +20,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["frames"] = frames.size();
   for (const auto& lidar : lidars) json["lidars"].push_back(lidar.name);
   std::vector<double> total, points_in, features_out;
-  std::size_t degenerate = 0, retried = 0, lost = 0;
+  std::size_t degenerate = 0, retried = 0, lost = 0, suspect = 0;
   for (std::size_t s = 0; s < slam::kStageCount; ++s) {
     std::vector<double> stage;
     for (const auto& f : frames) stage.push_back(f.seconds[s]);
@@ -34,12 +35,25 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
     features_out.push_back(static_cast<double>(f.edge_features + f.plane_features));
     degenerate += f.registration.degenerate ? 1 : 0;
     retried += f.retried ? 1 : 0;
-    lost += f.lost ? 1 : 0;
+    lost += f.lost() ? 1 : 0;
+    suspect += f.suspect() ? 1 : 0;
     const auto& r = f.registration;
-    per_frame.push_back({{"stamp", f.stamp}, {"eigenvalues", std::vector<double>(r.eigenvalues.data(), r.eigenvalues.data() + 6)},
-                         {"translation_observability", r.translation_observability}, {"degenerate", r.degenerate},
-                         {"lost", f.lost}, {"retried", f.retried}, {"iterations", r.iterations}, {"match_ratio", r.match_ratio()},
-                         {"threshold_m", f.threshold_m}, {"edges", f.edge_features}, {"planes", f.plane_features}});
+    per_frame.push_back({{"stamp", f.stamp},
+                         {"eigenvalues", std::vector<double>(r.eigenvalues.data(), r.eigenvalues.data() + 6)},
+                         {"translation_observability", r.translation_observability},
+                         {"degenerate", r.degenerate},
+                         {"lost", f.lost()},
+                         {"suspect", f.suspect()},
+                         {"trust", slam::trust_name(f.trust)},
+                         {"recent_residual_m", std::isfinite(f.recent_residual_m) ? nlohmann::json(f.recent_residual_m) : nlohmann::json()},
+                         {"retried", f.retried},
+                         {"iterations", r.iterations},
+                         {"converged", r.converged},
+                         {"match_ratio", r.match_ratio()},
+                         {"mean_residual_m", r.mean_residual_m},
+                         {"threshold_m", f.threshold_m},
+                         {"edges", f.edge_features},
+                         {"planes", f.plane_features}});
   }
   json["total_seconds"] = timing_summary(total);
   json["points_in"] = timing_summary(points_in);
@@ -47,6 +61,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["degenerate_frames"] = degenerate;
   json["retried_frames"] = retried;
   json["lost_frames"] = lost;
+  json["suspect_frames"] = suspect;
   json["per_frame"] = std::move(per_frame);
   return json;
 }

@@ -33,85 +33,143 @@ struct Field {
 constexpr Range kPositive{0.0, 1e9, true, false};
 constexpr Range kFraction{0.0, 1.0, true, true};
 
-/// The schema: one row per key, bound to `c`'s members.
-std::vector<Field> fields(SlamConfig& c) {
+std::vector<Field> initialization_fields(SlamConfig& c) {
   calib::OnlineHandEyeConfig& init = c.initialization;
-  calib::ShockDetectorConfig& shock = c.shock;
-  slam::OdometryConfig& odo = c.odometry;
   return {
-      {"initialization", "max_constraints", {2, 1e5}, "K: motion pairs kept; when full the smallest rotation is dropped",
+      {"initialization",
+       "max_constraints",
+       {2, 1e5},
+       "K: motion pairs kept; when full the smallest rotation is dropped",
        &init.max_constraints},
       {"initialization", "rotation_threshold", kPositive, "sigma_R: rotation ready when sigma_min2(Q_K) exceeds it",
        &init.rotation_threshold},
-      {"initialization", "huber_delta_rad", {0.0, 3.15, true, false}, "eq 4.17 Huber threshold on the residual angle",
+      {"initialization",
+       "huber_delta_rad",
+       {0.0, 3.15, true, false},
+       "eq 4.17 Huber threshold on the residual angle",
        &init.huber_delta_rad},
-      {"initialization", "planar_ratio", kFraction, "planar motion below this eigenvalue ratio of eq 4.18",
-       &init.planar_ratio},
-      {"initialization", "translation_min_ratio", kFraction,
-       "translation solvable above this ratio (< planar_ratio)", &init.translation_min_ratio},
+      {"initialization", "planar_ratio", kFraction, "planar motion below this eigenvalue ratio of eq 4.18", &init.planar_ratio},
+      {"initialization", "translation_min_ratio", kFraction, "translation solvable above this ratio (< planar_ratio)",
+       &init.translation_min_ratio},
       {"initialization", "translation_max_std_m", kPositive, "ready only when eq 4.18's predicted std of t is below this (m)",
        &init.translation_max_std_m},
-      {"initialization", "translation_min_pairs", {2, 1e5}, "fewer translation-valid pairs: translation not solved",
+      {"initialization",
+       "translation_min_pairs",
+       {2, 1e5},
+       "fewer translation-valid pairs: translation not solved",
        &init.translation_min_pairs},
-      {"initialization", "planar_rotation", {}, "one rotation axis: start from eq 3.8-3.12, t along the axis from the ground",
+      {"initialization",
+       "planar_rotation",
+       {},
+       "one rotation axis: start from eq 3.8-3.12, t along the axis from the ground",
        &init.planar_rotation},
       {"initialization", "planar_min_condition", kFraction, "eq 3.12 system's s_min / s_max needed for that start",
        &init.planar_min_condition},
-      {"initialization", "planar_min_pairs", {3, 1e5}, "fewer stored pairs: no planar start (few short pairs share an axis too)",
+      {"initialization",
+       "planar_min_pairs",
+       {3, 1e5},
+       "fewer stored pairs: no planar start (few short pairs share an axis too)",
        &init.planar_min_pairs},
-      {"initialization", "reinitialize_after_windows", {0, 1e5},
+      {"initialization",
+       "reinitialize_after_windows",
+       {0, 1e5},
        "calibration windows not accepted with a high residual ratio before re-initializing (0: never)",
        &c.start.reinitialize_windows},
-      {"initialization", "reinitialize_residual_ratio", kPositive,
-       "high: the window's map residual above this times the base LiDAR's", &c.start.reinitialize_residual_ratio},
-      {"initialization", "zero_translation_after_pairs", {0, 1e5},
+      {"initialization", "reinitialize_residual_ratio", kPositive, "high: the window's map residual above this times the base LiDAR's",
+       &c.start.reinitialize_residual_ratio},
+      {"initialization",
+       "zero_translation_after_pairs",
+       {0, 1e5},
        "pairs with the rotation ready but not the translation before the window starts from t = 0 (0: never)",
        &c.start.zero_translation_after_pairs},
-      {"convergence", "lambda_calib", kPositive, "accept a window's extrinsic when lambda_min exceeds it",
-       &c.convergence.lambda_calib},
-      {"convergence", "accepted_needed", {2, 1e5}, "L_calib: accepted estimates averaged at convergence",
-       &c.convergence.accepted_needed},
-      {"convergence", "bias_translation_sd_m", {0.0, 10.0}, "per-axis 1-sigma (m) of the error all windows share, added to Xi_calib",
+  };
+}
+
+std::vector<Field> convergence_fields(SlamConfig& c) {
+  return {
+      {"convergence", "lambda_calib", kPositive, "accept a window's extrinsic when lambda_min exceeds it", &c.convergence.lambda_calib},
+      {"convergence", "accepted_needed", {2, 1e5}, "L_calib: accepted estimates averaged at convergence", &c.convergence.accepted_needed},
+      {"convergence",
+       "bias_translation_sd_m",
+       {0.0, 10.0},
+       "per-axis 1-sigma (m) of the error all windows share, added to Xi_calib",
        &c.convergence.bias_translation_sd_m},
-      {"convergence", "bias_rotation_sd_deg", {0.0, 180.0}, "per-axis 1-sigma (deg) of the error all windows share, added to Xi_calib",
+      {"convergence",
+       "bias_rotation_sd_deg",
+       {0.0, 180.0},
+       "per-axis 1-sigma (deg) of the error all windows share, added to Xi_calib",
        &c.convergence.bias_rotation_sd_deg},
-      {"convergence", "outlier_mads", {0.0, 100.0}, "accepted estimates beyond this many robust sigmas of the median are left out of the mean (0: none)",
+      {"convergence",
+       "outlier_mads",
+       {0.0, 100.0},
+       "accepted estimates beyond this many robust sigmas of the median are left out of the mean (0: none)",
        &c.convergence.outlier_mads},
+  };
+}
+
+std::vector<Field> window_fields(SlamConfig& c) {
+  return {
       {"window", "size", {1, 100}, "N: the window holds N + 1 states", &c.window.size},
       {"window", "pivot", {1, 100}, "p: pivot state, origin of the local map (<= size)", &c.window.pivot},
-      {"window", "uncertainty_threshold", kPositive, "w: threshold for filtering uncertain points in mapping",
-       &c.window.uncertainty_threshold},
-      {"window", "extrinsic_covariance_scale", {1.0, 1e6}, "alpha: scale of the extrinsic covariance",
+      {"window",
+       "extrinsic_covariance_scale",
+       {1.0, 1e6},
+       "alpha: scale of the extrinsic covariance",
        &c.window.extrinsic_covariance_scale},
-      {"window", "refine_odometry", {}, "refine the trusted odometry's poses in the N + 1 window (eq 4.22)",
-       &c.window.refine_odometry},
-      {"window", "calibration_settle_passes", {0, 100},
+      {"window", "refine_odometry", {}, "refine the trusted odometry's poses in the N + 1 window (eq 4.22)", &c.window.refine_odometry},
+      {"window",
+       "calibration_settle_passes",
+       {0, 100},
        "extra re-matching passes of a calibration window until its estimate moves < 3 mm / 0.03 deg (0: two passes only)",
        &c.window.calibration_settle_passes},
+  };
+}
+
+std::vector<Field> shock_fields(SlamConfig& c) {
+  calib::ShockDetectorConfig& shock = c.shock;
+  return {
       {"shock", "history", {3, 1e5}, "normal frames in the robust baseline", &shock.history},
       {"shock", "min_history", {3, 1e5}, "no decision before this many (<= history)", &shock.min_history},
-      {"shock", "threshold_mads", {0.0, 100.0, true, false}, "robust z-score of a high frame",
-       &shock.threshold_mads},
-      {"shock", "min_relative_jump", {0.0, 100.0, true, false}, "and at least this relative residual rise",
-       &shock.min_relative_jump},
-      {"shock", "consecutive", {1, 1000}, "k: high frames in a row that trigger re-calibration",
-       &shock.consecutive},
-      {"shock", "relative_to_others", {}, "score against the other LiDARs' median residual",
-       &shock.relative_to_others},
-      {"odometry", "plane_voxel_m", {0.0, 100.0, true, false}, "voxel size of the local plane map",
-       &odo.plane_voxel_m},
+      {"shock", "threshold_mads", {0.0, 100.0, true, false}, "robust z-score of a high frame", &shock.threshold_mads},
+      {"shock", "min_relative_jump", {0.0, 100.0, true, false}, "and at least this relative residual rise", &shock.min_relative_jump},
+      {"shock", "consecutive", {1, 1000}, "k: high frames in a row that trigger re-calibration", &shock.consecutive},
+      {"shock", "relative_to_others", {}, "score against the other LiDARs' median residual", &shock.relative_to_others},
+  };
+}
+
+std::vector<Field> odometry_fields(SlamConfig& c) {
+  slam::OdometryConfig& odo = c.odometry;
+  return {
+      {"odometry", "plane_voxel_m", {0.0, 100.0, true, false}, "voxel size of the local plane map", &odo.plane_voxel_m},
       {"odometry", "edge_voxel_m", {0.0, 100.0, true, false}, "voxel size of the local edge map", &odo.edge_voxel_m},
-      {"odometry", "local_map_radius_m", {0.0, 1e4, true, false}, "voxels farther are dropped",
-       &odo.local_map_radius_m},
-      {"odometry", "max_iterations", {1, 1000}, "registration iterations per frame",
-       &odo.registration.max_iterations},
-      {"odometry", "refine_deskew", {}, "deskew each frame again with the velocity its registration measured and register once more",
+      {"odometry", "local_map_radius_m", {0.0, 1e4, true, false}, "voxels farther are dropped", &odo.local_map_radius_m},
+      {"odometry", "max_iterations", {1, 1000}, "registration iterations per frame", &odo.registration.max_iterations},
+      {"odometry",
+       "refine_deskew",
+       {},
+       "deskew each frame again with the velocity its registration measured and register once more",
        &odo.refine_deskew},
-      {"odometry", "deskew_in_registration", {}, "deskew the features again between registration iterations with the velocity the estimate implies",
+      {"odometry",
+       "deskew_in_registration",
+       {},
+       "deskew the features again between registration iterations with the velocity the estimate implies",
        &odo.deskew_in_registration},
-      {"odometry", "huber_delta_m", {0.0, 100.0, true, false}, "Huber scale on point residuals (eq 4.9's rho)",
+      {"odometry",
+       "huber_delta_m",
+       {0.0, 100.0, true, false},
+       "Huber scale on point residuals (eq 4.9's rho)",
        &odo.registration.huber_delta_m},
   };
+}
+
+/// The schema: one row per key, bound to `c`'s members, section by section.
+std::vector<Field> fields(SlamConfig& c) {
+  std::vector<Field> all;
+  for (auto* section : {&initialization_fields, &convergence_fields, &window_fields, &shock_fields, &odometry_fields}) {
+    const std::vector<Field> rows = section(c);
+    all.insert(all.end(), rows.begin(), rows.end());
+  }
+  return all;
 }
 
 std::string number_text(double v) {
@@ -129,17 +187,20 @@ std::string short_number(double v) {
 std::string range_text(const Field& f) {
   if (std::holds_alternative<bool*>(f.target)) return "true or false";
   const bool integer = !std::holds_alternative<double*>(f.target);
-  return std::string(integer ? "an integer in " : "a number in ") + (f.range.lo_open ? "(" : "[") +
-         short_number(f.range.lo) + ", " + short_number(f.range.hi) + (f.range.hi_open ? ")" : "]");
+  return std::string(integer ? "an integer in " : "a number in ") + (f.range.lo_open ? "(" : "[") + short_number(f.range.lo) + ", " +
+         short_number(f.range.hi) + (f.range.hi_open ? ")" : "]");
 }
 
 std::string value_text(const Field& f) {
   return std::visit(
       [](auto* p) -> std::string {
         using T = std::remove_pointer_t<decltype(p)>;
-        if constexpr (std::is_same_v<T, bool>) return *p ? "true" : "false";
-        else if constexpr (std::is_same_v<T, double>) return number_text(*p);
-        else return std::to_string(*p);
+        if constexpr (std::is_same_v<T, bool>)
+          return *p ? "true" : "false";
+        else if constexpr (std::is_same_v<T, double>)
+          return number_text(*p);
+        else
+          return std::to_string(*p);
       },
       f.target);
 }
@@ -216,9 +277,7 @@ SlamConfig parse_slam_config(const std::string& yaml_text, const std::string& so
   return config;
 }
 
-SlamConfig read_slam_config(const std::filesystem::path& file) {
-  return parse_slam_config(io::read_file_text(file), file.string());
-}
+SlamConfig read_slam_config(const std::filesystem::path& file) { return parse_slam_config(io::read_file_text(file), file.string()); }
 
 std::string slam_config_yaml(const SlamConfig& config) {
   SlamConfig copy = config;

@@ -1,8 +1,9 @@
 #pragma once
 // Parameters of `mlidar slam` (the M-LOAM back end, thesis Ch. 4) and their
 // strict reader for `--config mloam.yaml`. Defaults are Table 4.2:
-//   sigma_R = 0.25, lambda_calib = 70, L_calib = 25, N = 4, p = 2, w = 100, alpha = 1,
-// and K = 300 (Sec. 4.6.2.1). The documented example with every key is
+//   sigma_R = 0.25, lambda_calib = 70, L_calib = 25, N = 4, p = 2, alpha = 1,
+// and K = 300 (Sec. 4.6.2.1); Table 4.2's w (the mapping's uncertain-point filter) is not
+// implemented and has no key. The documented example with every key is
 // config/mloam.yaml. Every key is optional (absent = default); an unknown
 // key, a wrong type or a value out of range throws InputError naming the
 // file, the key (section.key) and the allowed range.
@@ -21,7 +22,6 @@ namespace mlidar::pipelines {
 struct WindowParams {
   int size = 4;                             ///< N: the window holds N + 1 states
   int pivot = 2;                            ///< p: the pivot state, origin of the local map, 1 <= p <= N
-  double uncertainty_threshold = 100.0;     ///< w: threshold for filtering uncertain points in mapping
   double extrinsic_covariance_scale = 1.0;  ///< alpha >= 1: scale of the extrinsic covariance (10 under large perturbation)
   /// Refine the trusted odometry's poses in the sliding window (eq 4.22, slam_pose_window.hpp).
   bool refine_odometry = false;
@@ -48,7 +48,7 @@ struct SlamConfig {
   /// Re-calibration trigger; a rise below 2x is not a shock: a sustained 1.45-1.76x rise of one LiDAR's residual
   /// ratio in part of the simulated room fired a false trigger (43 m protocol, room seed 6), Table 4.6's shock is 6x.
   calib::ShockDetectorConfig shock{.min_relative_jump = 1.0};
-  slam::OdometryConfig odometry;              ///< front end and scan-to-map registration
+  slam::OdometryConfig odometry;  ///< front end and scan-to-map registration
 };
 
 /// One documented key: "section.key", its allowed range in words, its meaning.

@@ -10,58 +10,108 @@
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/dataset.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/frame_source.hpp"
 #include "mlidar/io/trajectory_io.hpp"
-#include "mlidar/pipelines/odometry_job.hpp"
+#include "mlidar/pipelines/base_frame.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/pipelines/slam_metrics.hpp"
 
 namespace mlidar::pipelines {
 namespace {
 
-/// The dataset's LiDARs in the estimator's order (base first, then by name) and their clouds per frame.
-struct SlamInputs {
-  io::Dataset dataset;
-  std::vector<std::size_t> order;  ///< estimator index -> dataset index
-  std::vector<slam::LidarSetup> lidars;  ///< estimator order
-  std::vector<double> stamps;
-  std::vector<std::vector<std::optional<std::filesystem::path>>> clouds;  ///< [estimator lidar][frame]
-};
-
-SlamInputs read_inputs(const std::filesystem::path& folder) {
-  SlamInputs in;
-  in.dataset = io::read_dataset_yaml(folder);
-  in.stamps = io::read_times(folder / in.dataset.times);
-  const auto& lidars = in.dataset.lidars;
-  in.order.resize(lidars.size());
-  std::iota(in.order.begin(), in.order.end(), std::size_t{0});
-  const auto is_base = [&](std::size_t i) { return lidars[i].name == in.dataset.base; };
-  const bool base_listed = std::any_of(in.order.begin(), in.order.end(), is_base);
-  std::sort(in.order.begin(), in.order.end(), [&](std::size_t a, std::size_t b) {
-    if (base_listed && is_base(a) != is_base(b)) return is_base(a);
-    if (!base_listed && (a == 0) != (b == 0)) return a == 0;
+/// The source's LiDARs in the estimator's order: base first, then by name.
+std::vector<std::size_t> estimator_order(const io::FrameSource& source) {
+  const auto& lidars = source.lidars();
+  std::vector<std::size_t> order(lidars.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const std::size_t base = source.reference_index().value_or(0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    if ((a == base) != (b == base)) return a == base;
     return lidars[a].name < lidars[b].name;
   });
-  for (const std::size_t i : in.order) {
-    in.lidars.push_back({lidars[i].name, lidars[i].model, lidars[i].initial_extrinsic.value_or(SE3::identity())});
-    in.clouds.push_back(frame_clouds(folder / lidars[i].scans, in.stamps.size()));
-  }
-  return in;
+  return order;
 }
 
-std::vector<std::optional<Scan>> load_frame(const SlamInputs& in, std::size_t k) {
-  std::vector<std::optional<Scan>> scans;
-  for (const auto& clouds : in.clouds) {
-    if (clouds[k]) scans.push_back(load_dataset_scan(*clouds[k], in.stamps[k]));
-    else scans.emplace_back();
+/// The estimator's LiDARs, their given extrinsics relative to the reference LiDAR.
+std::vector<slam::LidarSetup> estimator_setups(const io::FrameSource& source, const std::vector<std::size_t>& order,
+                                               const BaseFrame& frame) {
+  std::vector<slam::LidarSetup> setups;
+  for (const std::size_t i : order) {
+    const io::SourceLidar& lidar = source.lidars()[i];
+    setups.push_back({lidar.name, lidar.model, frame.extrinsic_to_reference(lidar.initial_extrinsic.value_or(frame.T_base_reference))});
   }
-  return scans;
+  return setups;
 }
 
-void write_extrinsics_file(const std::filesystem::path& path, const SlamInputs& in, const std::vector<SlamLidarReport>& reports) {
+void write_extrinsics_file(const std::filesystem::path& path, const BaseFrame& frame, const std::vector<SlamLidarReport>& reports) {
   io::Extrinsics extrinsics;
-  extrinsics.base = in.dataset.base;
+  extrinsics.base = frame.name;
   for (const auto& report : reports) extrinsics.lidars.push_back({report.name, report.T_base_lidar, report.covariance});
   io::write_extrinsics(path, extrinsics);
+}
+
+/// A report from the reference LiDAR's frame into the base frame.
+SlamLidarReport report_in_base(SlamLidarReport report, const BaseFrame& frame) {
+  report.T_base_lidar = frame.extrinsic_to_base(report.T_base_lidar);
+  if (report.covariance) report.covariance = frame.covariance_to_base(*report.covariance);
+  return report;
+}
+
+/// The records of every frame, in order.
+struct SlamRun {
+  std::vector<SlamFrame> frames;
+  std::vector<double> load_seconds;
+  std::vector<slam::WindowPose> revisions;  ///< the window's final estimates of earlier frames, in the order given
+};
+
+SlamRun run_frames(const io::FrameSource& source, const std::vector<std::size_t>& order, SlamEstimator& estimator, FrameGaps& gaps,
+                   const std::function<void(int, int)>& progress) {
+  SlamRun run;
+  for (std::size_t k = 0; k < source.frames(); ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    io::SourceFrame frame = source.read(k);
+    std::vector<std::optional<Scan>> scans;
+    for (const std::size_t i : order) scans.push_back(std::move(frame.scans[i]));
+    gaps.add(frame.skipped);
+    run.load_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    run.frames.push_back(estimator.process(frame.stamp, scans));
+    if (const auto& settled = run.frames.back().settled) run.revisions.push_back(*settled);
+    if (progress) progress(static_cast<int>(k + 1), static_cast<int>(source.frames()));
+  }
+  const std::vector<slam::WindowPose> unsettled = estimator.unsettled_poses();
+  run.revisions.insert(run.revisions.end(), unsettled.begin(), unsettled.end());
+  return run;
+}
+
+/// T_world_base at every frame: the window's last revision of it where there is one, else the frame's own estimate.
+Trajectory final_trajectory(const SlamRun& run, const BaseFrame& frame) {
+  std::vector<const SE3*> pose(run.frames.size());
+  for (std::size_t k = 0; k < run.frames.size(); ++k) pose[k] = &run.frames[k].T_world_base;
+  for (const slam::WindowPose& revision : run.revisions) pose.at(revision.frame) = &revision.T_world_base;
+  Trajectory trajectory;
+  for (std::size_t k = 0; k < run.frames.size(); ++k) trajectory.poses.push_back({run.frames[k].stamp, frame.pose_to_base(*pose[k])});
+  return trajectory;
+}
+
+SlamJobSummary summarize(const SlamRun& run, const SlamEstimator& estimator, const std::vector<std::size_t>& order, const FrameGaps& gaps,
+                         const SlamJob& job, const BaseFrame& frame) {
+  SlamJobSummary summary;
+  summary.frames = run.frames.size();
+  summary.trajectory = final_trajectory(run, frame);
+  summary.gaps = gaps.summary_lines();
+  summary.base_failure = gaps.base_failure(job.max_base_gaps, frame.reference);
+  const std::vector<SlamLidarReport> reports = estimator.lidar_reports(run.frames);
+  summary.lidars.resize(reports.size());
+  for (std::size_t e = 0; e < reports.size(); ++e) summary.lidars[order[e]] = report_in_base(reports[e], frame);
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    const auto& f = run.frames[k];
+    summary.lost_frames += f.lost ? 1 : 0;
+    if (f.suspect) summary.suspect_frames.push_back(k);
+    const auto& s = f.seconds;
+    summary.mean_frame_seconds +=
+        (s.odometry + s.initialization + s.calibration + s.shock + s.window) / static_cast<double>(run.frames.size());
+  }
+  return summary;
 }
 
 }  // namespace
@@ -71,49 +121,30 @@ bool SlamJobSummary::all_converged() const {
 }
 
 SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, int)>& progress) {
-  if (job.calibrate != "online" && job.calibrate != "refine" && job.calibrate != "fixed")
-    throw UsageError("--calibrate must be online, refine or fixed, not '" + job.calibrate + "'");
   if (job.threads < 0) throw UsageError("--threads must be >= 0");
-  if (job.dataset.empty()) throw UsageError("--dataset DIR is required");
   const SlamConfig config = job.config.empty() ? SlamConfig{} : read_slam_config(job.config);
-  const SlamInputs in = read_inputs(job.dataset);
+  const io::FrameSource source = open_frames(job.dataset, job.bag, job.bag_options);
+  const std::vector<std::size_t> order = estimator_order(source);
   std::unique_ptr<tbb::global_control> threads;
-  if (job.threads > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
+  if (job.threads > 0)
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
 
-  const ExtrinsicSource source = job.calibrate == "online"   ? ExtrinsicSource::online
-                                : job.calibrate == "refine" ? ExtrinsicSource::refine
-                                                            : ExtrinsicSource::fixed;
-  SlamEstimator estimator(config, in.lidars, source);
-  std::vector<SlamFrame> frames;
-  std::vector<double> load_seconds;
-  for (std::size_t k = 0; k < in.stamps.size(); ++k) {
-    const auto start = std::chrono::steady_clock::now();
-    const auto scans = load_frame(in, k);
-    load_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    frames.push_back(estimator.process(in.stamps[k], scans));
-    if (const auto& settled = frames.back().settled) frames.at(settled->frame).T_world_base = settled->T_world_base;
-    if (progress) progress(static_cast<int>(k + 1), static_cast<int>(in.stamps.size()));
-  }
-
-  for (const slam::WindowPose& pose : estimator.unsettled_poses()) frames.at(pose.frame).T_world_base = pose.T_world_base;
-  SlamJobSummary summary;
-  summary.frames = frames.size();
-  const std::vector<SlamLidarReport> reports = estimator.lidar_reports();
-  summary.lidars.resize(reports.size());
-  for (std::size_t e = 0; e < reports.size(); ++e) summary.lidars[in.order[e]] = reports[e];
-  for (const auto& f : frames) {
-    summary.trajectory.poses.push_back({f.stamp, f.T_world_base});
-    summary.lost_frames += f.lost ? 1 : 0;
-    const auto& s = f.seconds;
-    summary.mean_frame_seconds += (s.odometry + s.initialization + s.calibration + s.shock + s.window) / static_cast<double>(frames.size());
-  }
+  const BaseFrame frame = base_frame(source);
+  SlamEstimator estimator(config, estimator_setups(source, order, frame), job.calibrate);
+  FrameGaps gaps(source);
+  const SlamRun run = run_frames(source, order, estimator, gaps, progress);
+  SlamJobSummary summary = summarize(run, estimator, order, gaps, job, frame);
   std::filesystem::create_directories(job.out);
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
-  write_extrinsics_file(job.out / "extrinsics.yaml", in, summary.lidars);
-  write_map_ply(job.out / "map.ply", estimator.map_points());
-  const std::string metrics = slam_metrics_json(frames, in.order, summary.lidars, load_seconds, job.calibrate).dump(2);
-  io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << metrics << '\n'; });
+  write_extrinsics_file(job.out / "extrinsics.yaml", frame, summary.lidars);
+  std::vector<Eigen::Vector3f> map = estimator.map_points();
+  for (Eigen::Vector3f& p : map) p = frame.point_to_base(p);
+  write_map_ply(job.out / "map.ply", std::move(map));
+  nlohmann::json metrics = slam_metrics_json(run.frames, order, summary.lidars, run.load_seconds, to_string(job.calibrate));
+  metrics["skipped_scans"] = gaps.json();
+  const std::string text = metrics.dump(2);
+  io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << text << '\n'; });
   return summary;
 }
 

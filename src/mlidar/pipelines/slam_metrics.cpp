@@ -23,8 +23,11 @@ nlohmann::json stage_timings(const std::vector<SlamFrame>& frames, const std::ve
     sum.push_back(f.seconds.odometry + f.seconds.initialization + f.seconds.calibration + f.seconds.shock + f.seconds.window);
   }
   total = timing_summary(sum);
-  return {{"load", timing_summary(load_seconds)}, {"odometry", timing_summary(odometry)}, {"initialization", timing_summary(initialization)},
-          {"calibration", timing_summary(calibration)}, {"shock", timing_summary(shock)},
+  return {{"load", timing_summary(load_seconds)},
+          {"odometry", timing_summary(odometry)},
+          {"initialization", timing_summary(initialization)},
+          {"calibration", timing_summary(calibration)},
+          {"shock", timing_summary(shock)},
           {"window", timing_summary(window)}};
 }
 
@@ -35,12 +38,19 @@ nlohmann::json pose_json(const SE3& T) {
 }
 
 nlohmann::json lidar_frame_json(const SlamLidarFrame& l) {
-  return {{"window_estimate", l.window_estimate ? pose_json(*l.window_estimate) : nlohmann::json(nullptr)}, {"role", std::string(to_string(l.role))}, {"scan_missing", l.scan_missing}, {"lambda_min", number_or_null(l.lambda_min)},
-          {"accepted", l.accepted}, {"mean_residual_m", number_or_null(l.mean_residual_m)}, {"shock", l.shock},
-          {"window_information", l.window_information ? nlohmann::json(std::vector<double>(l.window_information->data(), l.window_information->data() + 36))
-                                                      : nlohmann::json(nullptr)},
+  return {{"window_estimate", l.window_estimate ? pose_json(*l.window_estimate) : nlohmann::json(nullptr)},
+          {"role", std::string(to_string(l.role))},
+          {"scan_missing", l.scan_missing},
+          {"lambda_min", number_or_null(l.lambda_min)},
+          {"accepted", l.accepted},
+          {"mean_residual_m", number_or_null(l.mean_residual_m)},
+          {"shock", l.shock},
+          {"window_information", l.window_information
+                                     ? nlohmann::json(std::vector<double>(l.window_information->data(), l.window_information->data() + 36))
+                                     : nlohmann::json(nullptr)},
           {"window_residual_variance_m2", number_or_null(l.window_residual_variance_m2)},
-          {"window_step_m", number_or_null(l.window_step_m)}, {"window_step_deg", number_or_null(l.window_step_deg)},
+          {"window_step_m", number_or_null(l.window_step_m)},
+          {"window_step_deg", number_or_null(l.window_step_deg)},
           {"window_settled", l.window_settled},
           {"reinitialized", l.reinitialized}};
 }
@@ -50,7 +60,9 @@ nlohmann::json matrix_json_6(const Mat6& m) { return std::vector<double>(m.data(
 /// Xi_calib's terms (calib/extrinsic_covariance.hpp), null before convergence.
 nlohmann::json covariance_terms_json(const std::optional<calib::CalibrationCovariance>& parts) {
   if (!parts) return nullptr;
-  return {{"autocorrelation_time", parts->autocorrelation_time}, {"spread", matrix_json_6(parts->spread)}, {"bias", matrix_json_6(parts->bias)},
+  return {{"autocorrelation_time", parts->autocorrelation_time},
+          {"spread", matrix_json_6(parts->spread)},
+          {"bias", matrix_json_6(parts->bias)},
           {"windows", matrix_json_6(parts->windows)}};
 }
 
@@ -63,44 +75,48 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
   const Vec3 t = l.T_base_lidar.translation();
   nlohmann::json covariance = nullptr;
   if (l.covariance) covariance = std::vector<double>(l.covariance->data(), l.covariance->data() + 36);  // symmetric: order irrelevant
-  return {{"role", std::string(to_string(l.role))},
-          {"translation", {t.x(), t.y(), t.z()}},
-          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-          {"covariance", covariance},
-          {"covariance_terms", covariance_terms_json(l.covariance_parts)},
-          {"initialization",
-           {{"state", std::string(calib::to_string(init.state))},
-            {"frame", optional_json(l.initialized_frame)},
-            {"pairs_stored", init.pairs_stored},
-            {"pairs_seen", init.pairs_seen},
-            {"singular_values", init.singular_values},
-            {"translation_eigenvalues", init.translation_eigenvalues},
-            {"rotation_rms_rad", init.rotation_rms_rad},
-            {"planar_motion", init.planar_motion},
-            {"pairs_translation", init.pairs_translation},
-            {"translation_std_m", number_or_null(init.translation_std_m)},
-            {"planar_rotation", init.planar_rotation},
-            {"translation_start", l.translation_start.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.translation_start)},
-            {"unobservable_from_motion", l.unobservable_from_motion},
-            {"axis_translation_source", l.axis_translation_source.empty() ? nlohmann::json(nullptr) : nlohmann::json(l.axis_translation_source)},
-            {"observable_in_window", l.unobservable_from_motion.empty() ? nlohmann::json(nullptr) : nlohmann::json(window_observed(l))},
-            {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}}}},
-          {"converged_frame", optional_json(l.converged_frame)},
-          {"first_converged_frame", optional_json(l.first_converged_frame)},
-          {"accepted", l.accepted},
-          {"outlier_windows", l.outliers},
-          {"restarts", l.restarts},
-          {"shock_frames", l.shock_frames},
-          {"reinitialization_frames", l.reinitialization_frames},
-          {"missing_frames", l.missing_frames},
-          {"weak_directions", weak}};
+  return {
+      {"role", std::string(to_string(l.role))},
+      {"translation", {t.x(), t.y(), t.z()}},
+      {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+      {"covariance", covariance},
+      {"covariance_terms", covariance_terms_json(l.covariance_parts)},
+      {"initialization",
+       {{"state", std::string(calib::to_string(init.state))},
+        {"frame", optional_json(l.initialized_frame)},
+        {"pairs_stored", init.pairs_stored},
+        {"pairs_seen", init.pairs_seen},
+        {"singular_values", init.singular_values},
+        {"translation_eigenvalues", init.translation_eigenvalues},
+        {"rotation_rms_rad", init.rotation_rms_rad},
+        {"planar_motion", init.planar_motion},
+        {"pairs_translation", init.pairs_translation},
+        {"translation_std_m", number_or_null(init.translation_std_m)},
+        {"planar_rotation", init.planar_rotation},
+        {"translation_start",
+         l.translation_start == TranslationStart::none ? nlohmann::json(nullptr) : nlohmann::json(to_string(l.translation_start))},
+        {"unobservable_from_motion", l.unobservable_from_motion},
+        {"axis_translation_source", l.axis_translation_source == AxisTranslationSource::none
+                                        ? nlohmann::json(nullptr)
+                                        : nlohmann::json(to_string(l.axis_translation_source))},
+        {"observable_in_window", l.unobservable_from_motion.empty() ? nlohmann::json(nullptr) : nlohmann::json(window_observed(l))},
+        {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}}}},
+      {"converged_frame", optional_json(l.converged_frame)},
+      {"first_converged_frame", optional_json(l.first_converged_frame)},
+      {"accepted", l.accepted},
+      {"outlier_windows", l.outliers},
+      {"restarts", l.restarts},
+      {"shock_frames", l.shock_frames},
+      {"reinitialization_frames", l.reinitialization_frames},
+      {"missing_frames", l.missing_frames},
+      {"weak_directions", weak}};
 }
 
 }  // namespace
 
 nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std::vector<std::size_t>& order,
                                  const std::vector<SlamLidarReport>& lidars, const std::vector<double>& load_seconds,
-                                 const std::string& calibrate) {
+                                 std::string_view calibrate) {
   nlohmann::json json;
   json["frames"] = frames.size();
   json["calibrate"] = calibrate;
@@ -109,18 +125,24 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
   nlohmann::json total;
   json["stages"] = stage_timings(frames, load_seconds, total);
   json["total_seconds"] = total;
-  std::size_t lost = 0, changes = 0, calibrating = 0;
+  std::size_t lost = 0, suspect = 0, changes = 0, calibrating = 0;
   nlohmann::json per_frame = nlohmann::json::array();
   for (const auto& f : frames) {
     lost += f.lost ? 1 : 0;
+    suspect += f.suspect ? 1 : 0;
     changes += f.trusted_changed ? 1 : 0;
     calibrating += f.calibrating ? 1 : 0;
     nlohmann::json per_lidar = nlohmann::json::object();
     for (std::size_t e = 0; e < f.lidars.size(); ++e) per_lidar[lidars.at(order.at(e)).name] = lidar_frame_json(f.lidars[e]);
-    per_frame.push_back({{"stamp", f.stamp}, {"mode", f.calibrating ? "calibration" : "odometry"}, {"lost", f.lost},
-                         {"trusted_changed", f.trusted_changed}, {"lidars", per_lidar}});
+    per_frame.push_back({{"stamp", f.stamp},
+                         {"mode", f.calibrating ? "calibration" : "odometry"},
+                         {"lost", f.lost},
+                         {"suspect", f.suspect},
+                         {"trusted_changed", f.trusted_changed},
+                         {"lidars", per_lidar}});
   }
   json["lost_frames"] = lost;
+  json["suspect_frames"] = suspect;
   json["trusted_set_changes"] = changes;
   json["calibration_frames"] = calibrating;
   json["per_frame"] = std::move(per_frame);

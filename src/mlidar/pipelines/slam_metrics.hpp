@@ -16,6 +16,7 @@
 //               converged_frame (null), first_converged_frame (null), accepted, outlier_windows, restarts, shock_frames, missing_frames,
 //               weak_directions: [{description, eigenvalue}]}}
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -28,6 +29,6 @@ namespace mlidar::pipelines {
 /// estimator order); `lidars` in dataset order; `load_seconds` per frame.
 nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std::vector<std::size_t>& order,
                                  const std::vector<SlamLidarReport>& lidars, const std::vector<double>& load_seconds,
-                                 const std::string& calibrate);
+                                 std::string_view calibrate);
 
 }  // namespace mlidar::pipelines

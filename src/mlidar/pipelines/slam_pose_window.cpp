@@ -31,19 +31,18 @@ slam::OdometryWindowConfig odometry_window_config(const SlamConfig& config) {
 }
 
 std::optional<slam::OdometryWindowUpdate> SlamPoseWindow::add(std::size_t frame, const slam::FrameResult& result,
-                                                               const slam::Odometry& odometry) {
-  if (frame < 1 || result.lost) return std::nullopt;
+                                                              const slam::Odometry& odometry) {
+  if (frame < 1 || result.flagged()) return std::nullopt;
   if (!window_) {
     window_.emplace(config_, odometry.edge_map(), odometry.plane_map());  // frames 0 and 1, as rebuilt at frame 1
     return std::nullopt;
   }
   // registration.T_world_base: the pose at the time centroid, where the features are.
   const SE3& T_world_centroid = result.registration.T_world_base;
-  return window_->add(frame, trusted_features(odometry.lidar_features()), T_world_centroid, T_world_centroid.inverse() * result.T_world_base);
+  return window_->add(frame, trusted_features(odometry.lidar_features()), T_world_centroid,
+                      T_world_centroid.inverse() * result.T_world_base);
 }
 
-std::vector<slam::WindowPose> SlamPoseWindow::unsettled() const {
-  return window_ ? window_->unsettled() : std::vector<slam::WindowPose>{};
-}
+std::vector<slam::WindowPose> SlamPoseWindow::unsettled() const { return window_ ? window_->unsettled() : std::vector<slam::WindowPose>{}; }
 
 }  // namespace mlidar::pipelines

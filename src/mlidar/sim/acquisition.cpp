@@ -25,8 +25,7 @@ std::vector<Vec3> beam_directions(const LidarModel& model, int columns) {
     const double azimuth = -2.0 * std::numbers::pi * c / columns;
     for (const double elevation_deg : model.vertical_angles_deg) {
       const double elevation = elevation_deg * std::numbers::pi / 180.0;
-      directions.emplace_back(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                              std::sin(elevation));
+      directions.emplace_back(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
     }
   }
   return directions;
@@ -38,8 +37,8 @@ std::uint64_t sweep_seed(std::uint64_t seed, std::uint64_t frame, std::uint64_t 
   return mix(mix(mix(seed) ^ frame) ^ (lidar + 0x632be59bd9b4e019ULL));
 }
 
-SimulatedScan simulate_sweep(const Scene& scene, const SimLidar& lidar, const SimTrajectory& trajectory,
-                             double frame_stamp, std::uint64_t seed) {
+SimulatedScan simulate_sweep(const Scene& scene, const SimLidar& lidar, const SimTrajectory& trajectory, double frame_stamp,
+                             std::uint64_t seed) {
   const LidarModel& model = lidar.model;
   const int columns = columns_per_sweep(model);
   const std::size_t rings = model.rings();

@@ -21,14 +21,14 @@
 namespace mlidar::sim {
 
 struct SimulatedScan {
-  Scan scan;                    ///< stamp = frame stamp; time = seconds from it
-  std::vector<int> object_id;   ///< per point: labelled object hit, or -1
+  Scan scan;                   ///< stamp = frame stamp; time = seconds from it
+  std::vector<int> object_id;  ///< per point: labelled object hit, or -1
 };
 
 /// Simulates the sweep of `lidar` for the frame stamped `frame_stamp`.
 /// The noise and dropout draws come from std::mt19937_64(seed).
-SimulatedScan simulate_sweep(const Scene& scene, const SimLidar& lidar, const SimTrajectory& trajectory,
-                             double frame_stamp, std::uint64_t seed);
+SimulatedScan simulate_sweep(const Scene& scene, const SimLidar& lidar, const SimTrajectory& trajectory, double frame_stamp,
+                             std::uint64_t seed);
 
 /// An independent seed per (run seed, frame, LiDAR) (SplitMix64 mixing), so
 /// the output does not depend on the order or thread in which sweeps run.

@@ -5,13 +5,13 @@
 #include <numbers>
 #include <random>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/dataset.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
 #include "mlidar/io/pcd.hpp"
 #include "mlidar/sim/acquisition.hpp"
-#include "mlidar/sim/staged_folder.hpp"
 
 namespace mlidar::sim {
 namespace {
@@ -20,18 +20,16 @@ namespace fs = std::filesystem;
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kSide = 10.0;
 
-SE3 zyx(double yaw, double pitch, double roll, const Vec3& t) {
-  return SE3(Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
-                  Eigen::AngleAxisd(roll, Vec3::UnitX())),
-             t);
-}
+SE3 zyx(double yaw, double pitch, double roll, const Vec3& t) { return SE3(quat_from_rpy(Vec3(roll, pitch, yaw)), t); }
 
 SE3 configuration(int which, std::mt19937_64& rng) {
   if (which == 1) return zyx(2.7337, -0.3946, -0.1809, Vec3(0.8766, 0.4672, 1.0474));
   if (which == 2) return zyx(-0.5174, 0.1277, 0.1222, Vec3(1.3785, -1.3929, 1.3020));
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  return zyx(360.0 * kDeg * u(rng), 20.0 * kDeg * u(rng), 20.0 * kDeg * u(rng),
-             Vec3(3 * u(rng) - 1.5, 3 * u(rng) - 1.5, 3 * u(rng) - 1.5));
+  // Draws in statements of their own, last argument first (scene_layout.hpp: uniform).
+  const double z = 3 * u(rng) - 1.5, y = 3 * u(rng) - 1.5, x = 3 * u(rng) - 1.5;
+  const double roll = 20.0 * kDeg * u(rng), pitch = 20.0 * kDeg * u(rng), yaw = 360.0 * kDeg * u(rng);
+  return zyx(yaw, pitch, roll, Vec3(x, y, z));
 }
 
 /// Points of the three planes and the outliers, world frame (corner at origin).
@@ -45,21 +43,32 @@ std::vector<Vec3> corner_points(const CornerSpec& spec, double alpha, std::mt199
   std::vector<Vec3> points;
   points.reserve(static_cast<std::size_t>(spec.points));
   for (int i = 0; i < planar; ++i) {
+    // Draws in statements of their own, last argument first (scene_layout.hpp: uniform).
     Vec3 p;
     switch (i % 3) {
-      case 0: p = kSide * u(rng) * wall1 + Vec3(0, 0, kSide * u(rng)); break;
-      case 1: p = kSide * u(rng) * wall2 + Vec3(0, 0, kSide * u(rng)); break;
+      case 0: {
+        const double height = kSide * u(rng);
+        p = kSide * u(rng) * wall1 + Vec3(0, 0, height);
+        break;
+      }
+      case 1: {
+        const double height = kSide * u(rng);
+        p = kSide * u(rng) * wall2 + Vec3(0, 0, height);
+        break;
+      }
       default: {  // floor sector between the walls, uniform in area
         const double r = kSide * std::sqrt(u(rng));
         const double theta = alpha * u(rng);
         p = Vec3(r * std::cos(theta), r * std::sin(theta), 0.0);
       }
     }
-    points.push_back(p + Vec3(noise(rng), noise(rng), noise(rng)));
+    const double nz = noise(rng), ny = noise(rng), nx = noise(rng);
+    points.push_back(p + Vec3(nx, ny, nz));
   }
   const Vec3 middle(0.5 * kSide * std::cos(alpha / 2), 0.5 * kSide * std::sin(alpha / 2), 0.5 * kSide);
   while (static_cast<int>(points.size()) < spec.points) {
-    const Vec3 offset(spread(rng), spread(rng), spread(rng));
+    const double oz = spread(rng), oy = spread(rng), ox = spread(rng);
+    const Vec3 offset(ox, oy, oz);
     if ((offset.array().abs() <= 0.5 * kSide).all()) points.push_back(middle + offset);
   }
   return points;
@@ -93,8 +102,7 @@ void write_corner_dataset(const CornerSpec& spec, const fs::path& out) {
   std::mt19937_64 rng(spec.seed);
   const SE3 T_l1_l2 = configuration(spec.configuration, rng);
 
-  StagedFolder folder(out);
-  const fs::path& dir = folder.path();
+  const fs::path& dir = out;
   for (const char* name : {"l1", "l2"}) fs::create_directories(dir / "scans" / name);
   fs::create_directories(dir / "groundtruth");
   std::vector<double> stamps;
@@ -130,7 +138,6 @@ void write_corner_dataset(const CornerSpec& spec, const fs::path& out) {
   io::write_atomically(dir / "groundtruth" / "corner_angles.txt", [&](std::ostream& s) { s << angle_lines; });
   io::write_times(dir / "times.txt", stamps);
   io::write_dataset_yaml(dir / "dataset.yaml", dataset);
-  folder.commit();
 }
 
 }  // namespace mlidar::sim

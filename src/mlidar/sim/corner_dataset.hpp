@@ -32,7 +32,7 @@ struct CornerSpec {
   int configuration = 1;  ///< 1 or 2 (Table 2.2), 0 = random from the seed
 };
 
-/// UsageError for counts or angles out of range.
+/// Writes into the folder `out` as write_drive_dataset does. UsageError for counts or angles out of range.
 void write_corner_dataset(const CornerSpec& spec, const std::filesystem::path& out);
 
 }  // namespace mlidar::sim

@@ -1,5 +1,6 @@
 #include "mlidar/sim/drive_dataset.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -17,7 +18,6 @@
 #include "mlidar/sim/acquisition.hpp"
 #include "mlidar/sim/ground_truth.hpp"
 #include "mlidar/sim/scenes.hpp"
-#include "mlidar/sim/staged_folder.hpp"
 
 namespace mlidar::sim {
 namespace {
@@ -32,8 +32,13 @@ std::string frame_file(int frame, const char* extension) {
 
 Vec3 random_unit(std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  Vec3 v(normal(rng), normal(rng), normal(rng));
-  while (v.norm() < 1e-9) v = Vec3(normal(rng), normal(rng), normal(rng));
+  // Draws in statements of their own, last argument first (scene_layout.hpp: uniform).
+  const auto draw = [&] {
+    const double z = normal(rng), y = normal(rng);
+    return Vec3(normal(rng), y, z);
+  };
+  Vec3 v = draw();
+  while (v.norm() < 1e-9) v = draw();
   return v.normalized();
 }
 
@@ -42,12 +47,16 @@ io::Dataset describe(const DriveSpec& spec) {
   dataset.name = spec.rig.name + "-" + spec.scene;
   dataset.frame_period = spec.rig.frame_period();
   dataset.base = spec.rig.base_frame;
+  // A base frame that is no LiDAR (lyft's vehicle) is placed by the first LiDAR, whose extrinsic is given exactly.
+  const bool base_is_lidar = std::any_of(spec.rig.lidars.begin(), spec.rig.lidars.end(), [&](const auto& l) { return l.name == dataset.base; });
+  if (!base_is_lidar) dataset.reference_lidar = spec.rig.lidars.front().name;
   std::mt19937_64 rng(spec.seed ^ 0x7065727475726221ULL);
   for (const auto& lidar : spec.rig.lidars) {
     io::DatasetLidar entry{lidar.name, lidar.model, fs::path("scans") / lidar.name, lidar.T_base_lidar};
     const bool is_base = lidar.T_base_lidar.log().isZero(0.0);
-    if (!is_base) {
-      const Vec6 xi = (Vec6() << spec.perturb_m * random_unit(rng), spec.perturb_deg * std::numbers::pi / 180.0 * random_unit(rng)).finished();
+    if (!is_base && lidar.name != dataset.reference_lidar) {
+      const Vec6 xi =
+          (Vec6() << spec.perturb_m * random_unit(rng), spec.perturb_deg * std::numbers::pi / 180.0 * random_unit(rng)).finished();
       entry.initial_extrinsic = lidar.T_base_lidar * SE3::exp(xi);
     }
     dataset.lidars.push_back(entry);
@@ -64,8 +73,7 @@ io::Extrinsics true_extrinsics(const SimRig& rig) {
   return extrinsics;
 }
 
-void write_boxes(const fs::path& dir, int frame, const Scene& scene, const std::set<int>& seen, double stamp,
-                 const SE3& T_world_base) {
+void write_boxes(const fs::path& dir, int frame, const Scene& scene, const std::set<int>& seen, double stamp, const SE3& T_world_base) {
   std::vector<io::KittiObject> boxes;
   std::string ids;
   for (const int id : seen) {
@@ -86,15 +94,14 @@ void write_drive_dataset(const DriveSpec& spec, const fs::path& out, const Progr
   const double last_stamp = start + period * (spec.frames - 1);
   if (last_stamp + period > spec.trajectory.end_time() + 1e-9) {
     const int fit = static_cast<int>(std::floor((spec.trajectory.end_time() - start) / period + 1e-9));
-    throw UsageError("the trajectory covers " + std::to_string(spec.trajectory.end_time() - start) +
-                     " s: at most " + std::to_string(std::max(0, fit)) + " frames of " + std::to_string(period) + " s");
+    throw UsageError("the trajectory covers " + std::to_string(spec.trajectory.end_time() - start) + " s: at most " +
+                     std::to_string(std::max(0, fit)) + " frames of " + std::to_string(period) + " s");
   }
   std::vector<Vec3> path;
   for (int k = 0; k <= spec.frames; ++k) path.push_back(spec.trajectory.T_world_base(start + k * period).translation());
   const Scene scene = make_scene(spec.scene, spec.seed, path);
 
-  StagedFolder folder(out);
-  const fs::path& dir = folder.path();
+  const fs::path& dir = out;
   for (const auto& lidar : spec.rig.lidars) fs::create_directories(dir / "scans" / lidar.name);
   fs::create_directories(dir / "groundtruth");
   io::Dataset dataset = describe(spec);
@@ -129,7 +136,6 @@ void write_drive_dataset(const DriveSpec& spec, const fs::path& out, const Progr
   io::write_extrinsics(dir / "groundtruth" / "extrinsics.yaml", true_extrinsics(spec.rig));
   io::write_times(dir / "times.txt", stamps);
   io::write_dataset_yaml(dir / "dataset.yaml", dataset);
-  folder.commit();
 }
 
 }  // namespace mlidar::sim

@@ -34,8 +34,9 @@ struct DriveSpec {
 /// Called after each frame with (frames done, total).
 using ProgressFn = std::function<void(int, int)>;
 
-/// Writes the dataset to `out` (staged in a temporary folder, renamed at the end).
-/// UsageError: zero frames, a trajectory too short, or `out` unusable.
+/// Writes the dataset into the folder `out` (created when missing; meant to be new or empty: the CLI gives an
+/// io::RunFolder's staging folder, which makes the dataset appear whole or not at all). The spec is checked
+/// before anything is written: UsageError for zero frames or a trajectory too short.
 void write_drive_dataset(const DriveSpec& spec, const std::filesystem::path& out, const ProgressFn& progress = {});
 
 }  // namespace mlidar::sim

@@ -26,8 +26,8 @@ std::vector<double> hdl64_angles() {
   return angles;
 }
 
-LidarModel make(const std::string& name, std::vector<double> angles, double horizontal_deg, double min_range,
-                double max_range, double noise_sigma) {
+LidarModel make(const std::string& name, std::vector<double> angles, double horizontal_deg, double min_range, double max_range,
+                double noise_sigma) {
   LidarModel model;
   model.name = name;
   model.vertical_angles_deg = std::move(angles);
@@ -41,9 +41,7 @@ LidarModel make(const std::string& name, std::vector<double> angles, double hori
 
 }  // namespace
 
-std::vector<std::string> lidar_model_names() {
-  return {"VLP-16", "HDL-32E", "HDL-64E", "RS-LiDAR-16", "OS1-64", "PandarQT"};
-}
+std::vector<std::string> lidar_model_names() { return {"VLP-16", "HDL-32E", "HDL-64E", "RS-LiDAR-16", "OS1-64", "PandarQT"}; }
 
 LidarModel lidar_model(const std::string& name) {
   // Datasheet figures at 10 Hz: elevation table, azimuth step, range limits, range accuracy (1 sigma).

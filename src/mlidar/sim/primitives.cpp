@@ -47,8 +47,14 @@ std::optional<Hit> intersect_box(const Primitive& box, const Ray& ray, double t_
     double t0 = (-h - o[a]) / d[a];
     double t1 = (h - o[a]) / d[a];
     if (t0 > t1) std::swap(t0, t1);
-    if (t0 > t_enter) { t_enter = t0; axis_enter = a; }
-    if (t1 < t_exit) { t_exit = t1; axis_exit = a; }
+    if (t0 > t_enter) {
+      t_enter = t0;
+      axis_enter = a;
+    }
+    if (t1 < t_exit) {
+      t_exit = t1;
+      axis_exit = a;
+    }
   }
   if (t_enter > t_exit) return std::nullopt;
   const bool from_outside = t_enter > t_min;
@@ -81,8 +87,8 @@ std::optional<Hit> intersect_cylinder(const Primitive& cyl, const Ray& ray, doub
   };
   double r0 = 0.0;
   double r1 = 0.0;
-  if (solve_quadratic(d.x() * d.x() + d.y() * d.y(), o.x() * d.x() + o.y() * d.y(),
-                      o.x() * o.x() + o.y() * o.y() - cyl.radius * cyl.radius, r0, r1)) {
+  if (solve_quadratic(d.x() * d.x() + d.y() * d.y(), o.x() * d.x() + o.y() * d.y(), o.x() * o.x() + o.y() * o.y() - cyl.radius * cyl.radius,
+                      r0, r1)) {
     for (const double t : {r0, r1}) {
       const Vec3 p = o + t * d;
       if (std::abs(p.z()) <= h) consider(t, Vec3(p.x(), p.y(), 0.0).normalized());
@@ -102,8 +108,7 @@ std::optional<Hit> intersect_sphere(const Primitive& sphere, const Ray& ray, dou
   const Vec3 o = ray.origin - sphere.centre;
   double r0 = 0.0;
   double r1 = 0.0;
-  if (!solve_quadratic(1.0, o.dot(ray.direction), o.squaredNorm() - sphere.radius * sphere.radius, r0, r1))
-    return std::nullopt;
+  if (!solve_quadratic(1.0, o.dot(ray.direction), o.squaredNorm() - sphere.radius * sphere.radius, r0, r1)) return std::nullopt;
   for (const double t : {r0, r1}) {
     if (t > t_min && t <= t_max) return make_hit(t, (o + t * ray.direction) / sphere.radius, ray, sphere);
   }
@@ -130,11 +135,16 @@ Primitive Primitive::at_time(double t) const {
 
 std::optional<Hit> intersect(const Primitive& primitive, const Ray& ray, double t_min, double t_max) {
   switch (primitive.kind) {
-    case PrimitiveKind::kRectangle: return intersect_rectangle(primitive, ray, t_min, t_max);
-    case PrimitiveKind::kBox: return intersect_box(primitive, ray, t_min, t_max);
-    case PrimitiveKind::kCylinder: return intersect_cylinder(primitive, ray, t_min, t_max);
-    case PrimitiveKind::kSphere: return intersect_sphere(primitive, ray, t_min, t_max);
-    case PrimitiveKind::kGround: return intersect_ground(primitive, ray, t_min, t_max);
+    case PrimitiveKind::kRectangle:
+      return intersect_rectangle(primitive, ray, t_min, t_max);
+    case PrimitiveKind::kBox:
+      return intersect_box(primitive, ray, t_min, t_max);
+    case PrimitiveKind::kCylinder:
+      return intersect_cylinder(primitive, ray, t_min, t_max);
+    case PrimitiveKind::kSphere:
+      return intersect_sphere(primitive, ray, t_min, t_max);
+    case PrimitiveKind::kGround:
+      return intersect_ground(primitive, ray, t_min, t_max);
   }
   return std::nullopt;
 }
@@ -154,8 +164,10 @@ Bounds bounds(const Primitive& p) {
       const Vec3 reach(p.radius, p.radius, p.half_extent.z());
       return {p.centre - reach, p.centre + reach};
     }
-    case PrimitiveKind::kSphere: return {p.centre.array() - p.radius, p.centre.array() + p.radius};
-    case PrimitiveKind::kGround: break;
+    case PrimitiveKind::kSphere:
+      return {p.centre.array() - p.radius, p.centre.array() + p.radius};
+    case PrimitiveKind::kGround:
+      break;
   }
   return {Vec3::Constant(-inf), Vec3::Constant(inf)};
 }

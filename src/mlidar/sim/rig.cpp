@@ -1,5 +1,7 @@
 #include "mlidar/sim/rig.hpp"
 
+#include "mlidar/core/conversions.hpp"
+
 #include <numbers>
 
 #include "mlidar/core/error.hpp"
@@ -9,31 +11,17 @@
 namespace mlidar::sim {
 namespace {
 
-SimLidar mount(const std::string& name, const std::string& model, const Vec3& t, const Vec3& rpy_deg,
-               double sweep_offset = 0.0) {
+SimLidar mount(const std::string& name, const std::string& model, const Vec3& t, const Vec3& rpy_deg, double sweep_offset = 0.0) {
   SimLidar lidar;
   lidar.name = name;
   lidar.model = lidar_model(model);
-  lidar.T_base_lidar = SE3(rotation_from_rpy_deg(rpy_deg.x(), rpy_deg.y(), rpy_deg.z()), t);
+  lidar.T_base_lidar = SE3(quat_from_rpy_deg(rpy_deg), t);
   lidar.dropout_probability = 0.002;
   lidar.sweep_offset = sweep_offset;
   return lidar;
 }
 
 }  // namespace
-
-Quat rotation_from_rpy_deg(double roll, double pitch, double yaw) {
-  constexpr double deg = std::numbers::pi / 180.0;
-  return Quat(Eigen::AngleAxisd(yaw * deg, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch * deg, Vec3::UnitY()) *
-              Eigen::AngleAxisd(roll * deg, Vec3::UnitX()));
-}
-
-Rig SimRig::to_rig() const {
-  Rig rig;
-  rig.base_frame = base_frame;
-  for (const auto& lidar : lidars) rig.lidars.push_back({lidar.name, lidar.model, lidar.T_base_lidar, Mat6::Zero()});
-  return rig;
-}
 
 std::vector<std::string> rig_names() { return {"rhd", "rv", "lyft", "single-vlp16", "single-hdl64"}; }
 

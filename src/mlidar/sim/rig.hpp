@@ -51,7 +51,6 @@ struct SimRig {
   std::vector<SimLidar> lidars;
 
   double frame_period() const { return lidars.empty() ? 0.1 : lidars.front().model.sweep_period; }
-  Rig to_rig() const;
 };
 
 std::vector<std::string> rig_names();
@@ -61,8 +60,5 @@ SimRig named_rig(const std::string& name);
 SimRig parse_rig_yaml(const std::string& text, const std::string& source);
 /// A named rig, or a YAML file when `name_or_path` names an existing file or ends in .yaml/.yml.
 SimRig load_rig(const std::string& name_or_path);
-
-/// R = Rz(yaw) Ry(pitch) Rx(roll), angles in degrees.
-Quat rotation_from_rpy_deg(double roll, double pitch, double yaw);
 
 }  // namespace mlidar::sim

@@ -6,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/yaml_fields.hpp"
 #include "mlidar/sim/lidar_models.hpp"
@@ -27,8 +28,8 @@ class Reader : public io::YamlFields {
         fail(key, e.what());
       }
     }
-    only_keys(node, key, {"name", "vertical_angles_deg", "horizontal_resolution_deg", "min_range", "max_range",
-                          "range_noise_sigma", "sweep_period"});
+    only_keys(node, key,
+              {"name", "vertical_angles_deg", "horizontal_resolution_deg", "min_range", "max_range", "range_noise_sigma", "sweep_period"});
     LidarModel model;
     model.name = node["name"] ? text(node["name"], key + ".name") : "custom";
     if (!node["vertical_angles_deg"]) fail(key + ".vertical_angles_deg", "missing (one elevation per ring, degrees)");
@@ -62,7 +63,7 @@ class Reader : public io::YamlFields {
     if (node["rotation_rpy_deg"] && node["quaternion_wxyz"]) fail(key, "give rotation_rpy_deg or quaternion_wxyz, not both");
     if (node["rotation_rpy_deg"]) {
       const auto rpy = numbers(node["rotation_rpy_deg"], key + ".rotation_rpy_deg", 3);
-      q = rotation_from_rpy_deg(rpy[0], rpy[1], rpy[2]);
+      q = quat_from_rpy_deg(Vec3(rpy[0], rpy[1], rpy[2]));
     } else if (node["quaternion_wxyz"]) {
       const auto w = numbers(node["quaternion_wxyz"], key + ".quaternion_wxyz", 4);
       q = Quat(w[0], w[1], w[2], w[3]);
@@ -77,7 +78,6 @@ class Reader : public io::YamlFields {
     }
     return lidar;
   }
-
 };
 
 }  // namespace

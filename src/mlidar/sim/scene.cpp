@@ -9,8 +9,7 @@ bool LabelledObject::contains(const Vec3& p, double t, double margin) const {
   return (local.array().abs() <= (0.5 * size).array() + margin).all();
 }
 
-Scene::Scene(std::string name, const std::vector<Primitive>& primitives, std::vector<LabelledObject> objects,
-             double cell_size)
+Scene::Scene(std::string name, const std::vector<Primitive>& primitives, std::vector<LabelledObject> objects, double cell_size)
     : name_(std::move(name)), objects_(std::move(objects)) {
   std::vector<Primitive> gridded;
   for (const auto& p : primitives) {

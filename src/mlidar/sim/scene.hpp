@@ -31,8 +31,7 @@ class Scene {
  public:
   Scene() = default;
   /// Primitives with object_id >= 0 must refer to an entry of objects.
-  Scene(std::string name, const std::vector<Primitive>& primitives, std::vector<LabelledObject> objects,
-        double cell_size = 2.0);
+  Scene(std::string name, const std::vector<Primitive>& primitives, std::vector<LabelledObject> objects, double cell_size = 2.0);
 
   /// Nearest hit in (t_min, t_max] with moving primitives placed at `time`.
   std::optional<Hit> cast(const Ray& ray, double t_min, double t_max, double time) const;

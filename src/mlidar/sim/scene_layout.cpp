@@ -30,8 +30,7 @@ Primitive wall(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double z0, do
   axes.col(1) = Vec3::UnitZ();
   axes.col(2) = axes.col(0).cross(axes.col(1));
   const Eigen::Vector2d mid = 0.5 * (a + b);
-  return make_rectangle(Vec3(mid.x(), mid.y(), 0.5 * (z0 + z1)), axes, 0.5 * (b - a).norm(), 0.5 * (z1 - z0),
-                        reflectivity);
+  return make_rectangle(Vec3(mid.x(), mid.y(), 0.5 * (z0 + z1)), axes, 0.5 * (b - a).norm(), 0.5 * (z1 - z0), reflectivity);
 }
 
 Primitive slab(const Extent2& extent, double z, double reflectivity) {
@@ -51,8 +50,6 @@ void add_room_walls(const Extent2& e, double height, double reflectivity, std::v
   out.push_back(wall(c01, c00, 0.0, height, reflectivity));
 }
 
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
+double uniform(std::mt19937_64& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
 
 }  // namespace mlidar::sim::layout

@@ -26,6 +26,10 @@ Primitive slab(const Extent2& extent, double z, double reflectivity);
 /// Four walls around extent from the floor to height.
 void add_room_walls(const Extent2& extent, double height, double reflectivity, std::vector<Primitive>& out);
 
+/// Where several draws build one value, each is a statement of its own: the
+/// order of function arguments is unspecified (gcc took them last first, clang
+/// first first), and a dataset must not depend on the compiler. They are taken
+/// last argument first, as gcc did, so datasets made before stay identical.
 double uniform(std::mt19937_64& rng, double lo, double hi);
 
 }  // namespace mlidar::sim::layout

@@ -39,15 +39,18 @@ Scene room_scene(std::uint64_t seed, std::span<const Vec3> path) {
   add_room_walls(e, height, 0.6, primitives);
   // Furniture against the walls and free-standing pillars, kept off the path.
   for (int tries = 0, placed = 0; tries < 200 && placed < 8; ++tries) {
-    const Vec3 half(uniform(rng, 0.3, 1.0), uniform(rng, 0.3, 0.8), uniform(rng, 0.4, 1.0));
-    const Eigen::Vector2d xy(uniform(rng, e.min.x() + half.x(), e.max.x() - half.x()),
-                             uniform(rng, e.min.y() + half.y(), e.max.y() - half.y()));
+    // Draws in statements of their own, last argument first (scene_layout.hpp: uniform).
+    const double half_z = uniform(rng, 0.4, 1.0), half_y = uniform(rng, 0.3, 0.8), half_x = uniform(rng, 0.3, 1.0);
+    const Vec3 half(half_x, half_y, half_z);
+    const double y = uniform(rng, e.min.y() + half.y(), e.max.y() - half.y());
+    const Eigen::Vector2d xy(uniform(rng, e.min.x() + half.x(), e.max.x() - half.x()), y);
     if (distance_to_path(path, xy) < half.head<2>().norm() + 1.0) continue;
     primitives.push_back(make_box(Vec3(xy.x(), xy.y(), half.z()), 0.0, half, uniform(rng, 0.2, 0.8)));
     ++placed;
   }
   for (int tries = 0, placed = 0; tries < 100 && placed < 2; ++tries) {
-    const Eigen::Vector2d xy(uniform(rng, e.min.x() + 1.0, e.max.x() - 1.0), uniform(rng, e.min.y() + 1.0, e.max.y() - 1.0));
+    const double y = uniform(rng, e.min.y() + 1.0, e.max.y() - 1.0);
+    const Eigen::Vector2d xy(uniform(rng, e.min.x() + 1.0, e.max.x() - 1.0), y);
     if (distance_to_path(path, xy) < 1.5) continue;
     primitives.push_back(make_cylinder(Vec3(xy.x(), xy.y(), height / 2), 0.25, height / 2, 0.5));
     ++placed;

@@ -42,11 +42,13 @@ class Placer {
 
 void add_buildings(std::mt19937_64& rng, Placer& placer, int count, double clearance, std::vector<Primitive>& out) {
   for (int tries = 0, placed = 0; tries < 40 * count && placed < count; ++tries) {
-    const Vec3 half(uniform(rng, 4.0, 15.0), uniform(rng, 4.0, 12.0), uniform(rng, 3.0, 10.0));
+    // Draws in statements of their own, last argument first (scene_layout.hpp: uniform).
+    const double half_z = uniform(rng, 3.0, 10.0), half_y = uniform(rng, 4.0, 12.0), half_x = uniform(rng, 4.0, 15.0);
+    const Vec3 half(half_x, half_y, half_z);
     const Eigen::Vector2d xy = placer.random_point(rng);
     if (!placer.try_place({xy, half.head<2>().norm()}, clearance)) continue;
-    out.push_back(make_box(Vec3(xy.x(), xy.y(), half.z()), uniform(rng, 0.0, std::numbers::pi), half,
-                           uniform(rng, 0.3, 0.8)));
+    const double reflectivity = uniform(rng, 0.3, 0.8), yaw = uniform(rng, 0.0, std::numbers::pi);
+    out.push_back(make_box(Vec3(xy.x(), xy.y(), half.z()), yaw, half, reflectivity));
     ++placed;
   }
 }
@@ -83,7 +85,13 @@ Eigen::Vector2d path_heading(std::span<const Vec3> path, std::size_t i) {
 /// Cars and pedestrians beside the path: parked cars at 6.5 m either side,
 /// oncoming cars in the lane 3.5 m to the left, pedestrians on the sidewalks.
 void add_traffic(std::mt19937_64& rng, std::span<const Vec3> path, Placer& placer, std::vector<LabelledObject>& objects) {
-  struct Kind { const char* type; double lateral; double speed; int count; Vec3 size; };
+  struct Kind {
+    const char* type;
+    double lateral;
+    double speed;
+    int count;
+    Vec3 size;
+  };
   const Kind kinds[] = {{"Car", 6.5, 0.0, 10, Vec3(4.5, 1.8, 1.5)},
                         {"Car", 3.5, -7.0, 3, Vec3(4.6, 1.9, 1.5)},
                         {"Pedestrian", 8.5, 1.3, 6, Vec3(0.6, 0.6, 1.75)}};
@@ -95,7 +103,8 @@ void add_traffic(std::mt19937_64& rng, std::span<const Vec3> path, Placer& place
       const double side = kind.speed == 0.0 && uniform(rng, 0.0, 1.0) < 0.5 ? -1.0 : 1.0;
       const Eigen::Vector2d left(-heading.y(), heading.x());
       const Eigen::Vector2d xy = path[i].head<2>() + side * kind.lateral * left + uniform(rng, -3.0, 3.0) * heading;
-      const Vec3 size = kind.size.cwiseProduct(Vec3(uniform(rng, 0.9, 1.1), uniform(rng, 0.9, 1.1), uniform(rng, 0.9, 1.1)));
+      const double scale_z = uniform(rng, 0.9, 1.1), scale_y = uniform(rng, 0.9, 1.1), scale_x = uniform(rng, 0.9, 1.1);
+      const Vec3 size = kind.size.cwiseProduct(Vec3(scale_x, scale_y, scale_z));
       const double radius = 0.5 * size.head<2>().norm();
       if (!placer.try_place({xy, radius}, kind.lateral - 1.0 - radius)) continue;
       LabelledObject object;
@@ -121,7 +130,8 @@ Scene campus_scene(std::uint64_t seed, std::span<const Vec3> path) {
   std::mt19937_64 rng(seed);
   Placer placer(path, path_extent(path, 60.0));
   // Gentle slope (a few mm per metre) through the origin.
-  std::vector<Primitive> primitives{make_ground(0.0, Eigen::Vector2d(uniform(rng, -0.003, 0.003), uniform(rng, -0.003, 0.003)), 0.3)};
+  const double slope_y = uniform(rng, -0.003, 0.003), slope_x = uniform(rng, -0.003, 0.003);
+  std::vector<Primitive> primitives{make_ground(0.0, Eigen::Vector2d(slope_x, slope_y), 0.3)};
   add_buildings(rng, placer, scaled_count(placer.extent(), 1500.0), 5.0, primitives);
   add_trees(rng, placer, scaled_count(placer.extent(), 250.0), primitives);
   add_poles(rng, placer, scaled_count(placer.extent(), 800.0), primitives);

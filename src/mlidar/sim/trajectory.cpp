@@ -5,15 +5,11 @@
 #include <limits>
 #include <numbers>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
 
 namespace mlidar::sim {
 namespace {
-
-Quat ypr(double yaw, double pitch, double roll) {
-  return Quat(Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
-              Eigen::AngleAxisd(roll, Vec3::UnitX()));
-}
 
 /// Figure-eight x = a sin(w t), y = b sin(2 w t), heading along the velocity.
 struct FigureEight {
@@ -30,7 +26,7 @@ SE3 handheld_pose(double t, double height) {
   const double yaw = kWalk.heading(t) + 0.25 * std::sin(1.3 * t + 0.4);
   const double pitch = 0.15 * std::sin(0.9 * t + 1.1);
   const double roll = 0.2 * std::sin(1.1 * t + 2.0);
-  return SE3(ypr(yaw, pitch, roll), kWalk.position(t, height + bob));
+  return SE3(quat_from_rpy(Vec3(roll, pitch, yaw)), kWalk.position(t, height + bob));
 }
 
 /// Cumulative cubic B-spline basis (Kim et al. 1995): weights of the 3 differences.
@@ -113,11 +109,16 @@ SE3 SimTrajectory::spline_pose(double t) const {
 
 SE3 SimTrajectory::T_world_base(double t) const {
   switch (kind_) {
-    case TrajectoryKind::kStatic: return fixed_;
-    case TrajectoryKind::kHandheld: return handheld_pose(t, height_);
-    case TrajectoryKind::kVehicle: return SE3(ypr(kDrive.heading(t), 0.0, 0.0), kDrive.position(t, height_));
-    case TrajectoryKind::kCorridor: return SE3(Quat::Identity(), Vec3(1.5 * t, 0.0, height_));
-    case TrajectoryKind::kSpline: return spline_pose(t);
+    case TrajectoryKind::kStatic:
+      return fixed_;
+    case TrajectoryKind::kHandheld:
+      return handheld_pose(t, height_);
+    case TrajectoryKind::kVehicle:
+      return SE3(quat_from_rpy(Vec3(0.0, 0.0, kDrive.heading(t))), kDrive.position(t, height_));
+    case TrajectoryKind::kCorridor:
+      return SE3(Quat::Identity(), Vec3(1.5 * t, 0.0, height_));
+    case TrajectoryKind::kSpline:
+      return spline_pose(t);
   }
   return fixed_;
 }

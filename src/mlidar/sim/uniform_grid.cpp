@@ -11,8 +11,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr long kMaxCells = 4'000'000;
 }  // namespace
 
-UniformGrid::UniformGrid(std::vector<Primitive> primitives, double cell_size)
-    : primitives_(std::move(primitives)), cell_size_(cell_size) {
+UniformGrid::UniformGrid(std::vector<Primitive> primitives, double cell_size) : primitives_(std::move(primitives)), cell_size_(cell_size) {
   assert(cell_size > 0.0);
   if (primitives_.empty()) return;
   min_ = Vec3::Constant(kInf);

@@ -23,10 +23,10 @@ struct CalibrationFrame {
 };
 
 struct CalibrationWindowResult {
-  bool solved = false;             ///< false: fewer than 6 correspondences at some gate
-  SE3 T_base_lidar;                ///< the estimate (the start when not solved)
-  Mat6 information = Mat6::Zero(); ///< of the extrinsic, [t, r], left perturbation in the base frame
-  MapFit fit;                      ///< of the correspondences at the last gate
+  bool solved = false;              ///< false: fewer than 6 correspondences at some gate
+  SE3 T_base_lidar;                 ///< the estimate (the start when not solved)
+  Mat6 information = Mat6::Zero();  ///< of the extrinsic, [t, r], left perturbation in the base frame
+  MapFit fit;                       ///< of the correspondences at the last gate
   /// Residual variance per row at the solution, 2 F / (rows - 6) (F: the
   /// Huber cost, a plane one row, an edge two): sigma^2 with which
   /// sigma^2 information^-1 is the window's own covariance of the estimate.
@@ -35,18 +35,18 @@ struct CalibrationWindowResult {
   /// whose re-matching still moves it has not reached its own solution (a transient).
   double last_step_m = 0.0;
   double last_step_rad = 0.0;
-  int passes = 0;                  ///< re-matching passes run
-  bool settled = false;            ///< the last pass moved it less than the tolerances
+  int passes = 0;        ///< re-matching passes run
+  bool settled = false;  ///< the last pass moved it less than the tolerances
 };
 
 struct CalibrationWindowOptions {
   /// Correspondence gates (m), one re-matching pass each, coarse to fine: the hand-eye start may be a
   /// degree and centimetres off (0.5 m at 30 m range); the next pass matches at the previous solution.
   std::vector<double> gates_m{1.0, 0.3};
-  double huber_delta_m = 0.1;             ///< the window's Huber scale
-  int settle_passes = 4;                  ///< extra passes at the last gate at most (0: the gates only)
-  double settle_translation_m = 0.003;    ///< settled when a pass moves the estimate less than this...
-  double settle_rotation_rad = 5e-4;      ///< ... and this (0.029 deg)
+  double huber_delta_m = 0.1;           ///< the window's Huber scale
+  int settle_passes = 4;                ///< extra passes at the last gate at most (0: the gates only)
+  double settle_translation_m = 0.003;  ///< settled when a pass moves the estimate less than this...
+  double settle_rotation_rad = 5e-4;    ///< ... and this (0.029 deg)
 };
 
 CalibrationWindowResult solve_calibration_window(std::span<const CalibrationFrame> frames, const SE3& T_base_lidar, const MapView& map,

@@ -70,14 +70,17 @@ CeresWindowResult solve_window_ceres(const WindowProblem& problem, const WindowS
   SE3Manifold manifold;
   ceres::HuberLoss huber(options.huber_delta_m);  // rho(s) = s, or 2 delta sqrt(s) - delta^2: huber_loss of window_linearize
   for (const PlaneCorrespondence& c : problem.planes) {
-    auto* cost = new ceres::AutoDiffCostFunction<PlaneTerm, 1, 7, 7>(new PlaneTerm{c.point_lidar, c.plane_world.normal, c.plane_world.offset});
-    ceres_problem.AddResidualBlock(cost, &huber, poses[static_cast<std::size_t>(c.frame)].data(), extrinsics[static_cast<std::size_t>(c.lidar)].data());
+    auto* cost =
+        new ceres::AutoDiffCostFunction<PlaneTerm, 1, 7, 7>(new PlaneTerm{c.point_lidar, c.plane_world.normal, c.plane_world.offset});
+    ceres_problem.AddResidualBlock(cost, &huber, poses[static_cast<std::size_t>(c.frame)].data(),
+                                   extrinsics[static_cast<std::size_t>(c.lidar)].data());
   }
   for (const EdgeCorrespondence& c : problem.edges) {
     const Vec3 n1 = c.line_direction_world.unitOrthogonal();
     const Vec3 n2 = c.line_direction_world.cross(n1).normalized();
     auto* cost = new ceres::AutoDiffCostFunction<EdgeTerm, 2, 7, 7>(new EdgeTerm{c.point_lidar, c.line_point_world, n1, n2});
-    ceres_problem.AddResidualBlock(cost, &huber, poses[static_cast<std::size_t>(c.frame)].data(), extrinsics[static_cast<std::size_t>(c.lidar)].data());
+    ceres_problem.AddResidualBlock(cost, &huber, poses[static_cast<std::size_t>(c.frame)].data(),
+                                   extrinsics[static_cast<std::size_t>(c.lidar)].data());
   }
   const auto configure = [&](Block& block, bool fixed) {
     if (!ceres_problem.HasParameterBlock(block.data())) return;

@@ -15,14 +15,14 @@ namespace mlidar::slam {
 struct CeresWindowOptions {
   double huber_delta_m = 0.1;  ///< the same Huber scale as WindowSolverConfig
   int max_iterations = 10;
-  bool dense_qr = false;       ///< DENSE_QR instead of DENSE_NORMAL_CHOLESKY
+  bool dense_qr = false;  ///< DENSE_QR instead of DENSE_NORMAL_CHOLESKY
 };
 
 struct CeresWindowResult {
   WindowState state;
   double initial_cost = 0.0;  ///< 1/2 sum rho(|r|^2), as window_cost
   double final_cost = 0.0;
-  int iterations = 0;         ///< Ceres's successful steps
+  int iterations = 0;  ///< Ceres's successful steps
   bool converged = false;
 };
 

@@ -16,9 +16,8 @@ BodyVelocity BodyVelocity::from_relative_pose(const SE3& T_prev_curr, double dt)
 
 SE3 BodyVelocity::pose_at(double tau) const { return {so3_exp(tau * angular), tau * linear}; }
 
-void deskew_to_base(std::span<const Eigen::Vector3f> points, std::span<const float> times,
-                    std::span<const std::uint32_t> indices, const SE3& T_base_lidar, const BodyVelocity& velocity,
-                    std::span<Eigen::Vector3f> out) {
+void deskew_to_base(std::span<const Eigen::Vector3f> points, std::span<const float> times, std::span<const std::uint32_t> indices,
+                    const SE3& T_base_lidar, const BodyVelocity& velocity, std::span<Eigen::Vector3f> out) {
   const std::size_t count = indices.empty() ? points.size() : indices.size();
   if (out.size() != count) throw std::invalid_argument("deskew_to_base: out size differs from the selection");
   if (!times.empty() && times.size() != points.size()) throw std::invalid_argument("deskew_to_base: times size differs from points");

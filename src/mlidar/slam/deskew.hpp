@@ -32,9 +32,8 @@ struct BodyVelocity {
 /// must equal indices.size() (or points.size()); times has one entry per
 /// point or is empty (no motion: out = T_base_lidar p). Throws
 /// std::invalid_argument when sizes disagree or an index is out of range.
-void deskew_to_base(std::span<const Eigen::Vector3f> points, std::span<const float> times,
-                    std::span<const std::uint32_t> indices, const SE3& T_base_lidar, const BodyVelocity& velocity,
-                    std::span<Eigen::Vector3f> out);
+void deskew_to_base(std::span<const Eigen::Vector3f> points, std::span<const float> times, std::span<const std::uint32_t> indices,
+                    const SE3& T_base_lidar, const BodyVelocity& velocity, std::span<Eigen::Vector3f> out);
 
 /// Points deskewed with `used` (by deskew_to_base) deskewed again with `refined`:
 /// p = Exp(t w_r) Exp(-t w_u) (p_u - t v_u) + t v_r (the base-frame capture point

@@ -69,8 +69,8 @@ void row_curvature(std::span<const float> ranges, std::span<float> curvature) {
   }
 }
 
-void extract_features(const RangeImage& image, const Segmentation& segmentation, const FeatureConfig& config,
-                      FeatureWorkspace& ws, FeatureIndices& out) {
+void extract_features(const RangeImage& image, const Segmentation& segmentation, const FeatureConfig& config, FeatureWorkspace& ws,
+                      FeatureIndices& out) {
   out.edges.clear();
   out.planes.clear();
   std::vector<float>& ranges = ws.curvature;  // reused: ranges first, then kept separately below
@@ -99,26 +99,28 @@ void extract_features(const RangeImage& image, const Segmentation& segmentation,
       for (int i = begin; i < end; ++i)
         if (curvature[static_cast<std::size_t>(i)] > config.edge_threshold) ws.order.push_back(static_cast<std::uint32_t>(i));
       int edges = 0;
-      walk_in_order(ws.order, config.edges_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] > curvature[b]; },
-                    [&](std::uint32_t i) {
-                      const std::size_t pixel = ws.pixel[i];
-                      if (ws.blocked[i] != 0 || segmentation.label[pixel] == Segmentation::kGround) return false;
-                      out.edges.push_back(static_cast<std::uint32_t>(image.index[pixel]));
-                      block_neighbours(static_cast<int>(i), n, ws.blocked);
-                      return ++edges >= config.edges_per_sector;
-                    });
+      walk_in_order(
+          ws.order, config.edges_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] > curvature[b]; },
+          [&](std::uint32_t i) {
+            const std::size_t pixel = ws.pixel[i];
+            if (ws.blocked[i] != 0 || segmentation.label[pixel] == Segmentation::kGround) return false;
+            out.edges.push_back(static_cast<std::uint32_t>(image.index[pixel]));
+            block_neighbours(static_cast<int>(i), n, ws.blocked);
+            return ++edges >= config.edges_per_sector;
+          });
       // Planes: candidates below plane_threshold, lowest curvature first.
       ws.order.clear();
       for (int i = begin; i < end; ++i)
         if (curvature[static_cast<std::size_t>(i)] < config.plane_threshold) ws.order.push_back(static_cast<std::uint32_t>(i));
       int planes = 0;
-      walk_in_order(ws.order, config.planes_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] < curvature[b]; },
-                    [&](std::uint32_t i) {
-                      if (ws.blocked[i] != 0) return false;
-                      out.planes.push_back(static_cast<std::uint32_t>(image.index[ws.pixel[i]]));
-                      block_neighbours(static_cast<int>(i), n, ws.blocked);
-                      return ++planes >= config.planes_per_sector;
-                    });
+      walk_in_order(
+          ws.order, config.planes_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] < curvature[b]; },
+          [&](std::uint32_t i) {
+            if (ws.blocked[i] != 0) return false;
+            out.planes.push_back(static_cast<std::uint32_t>(image.index[ws.pixel[i]]));
+            block_neighbours(static_cast<int>(i), n, ws.blocked);
+            return ++planes >= config.planes_per_sector;
+          });
     }
   }
 }

@@ -39,7 +39,7 @@ struct FeatureIndices {
 
 /// Reusable per-row buffers so repeated calls do not allocate.
 struct FeatureWorkspace {
-  std::vector<std::uint32_t> pixel;   ///< kept pixels of the current row
+  std::vector<std::uint32_t> pixel;  ///< kept pixels of the current row
   std::vector<float> curvature;
   std::vector<std::uint8_t> blocked;
   std::vector<std::uint32_t> order;
@@ -49,7 +49,7 @@ struct FeatureWorkspace {
 /// the first and last 5 entries get +infinity (no full neighbourhood).
 void row_curvature(std::span<const float> ranges, std::span<float> curvature);
 
-void extract_features(const RangeImage& image, const Segmentation& segmentation, const FeatureConfig& config,
-                      FeatureWorkspace& workspace, FeatureIndices& out);
+void extract_features(const RangeImage& image, const Segmentation& segmentation, const FeatureConfig& config, FeatureWorkspace& workspace,
+                      FeatureIndices& out);
 
 }  // namespace mlidar::slam

@@ -14,7 +14,9 @@ namespace {
 class StageTimer {
  public:
   StageTimer(StageSeconds& seconds, Stage stage) : seconds_(seconds), stage_(stage), start_(std::chrono::steady_clock::now()) {}
-  ~StageTimer() { seconds_[static_cast<std::size_t>(stage_)] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  ~StageTimer() {
+    seconds_[static_cast<std::size_t>(stage_)] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
   StageTimer(const StageTimer&) = delete;
   StageTimer& operator=(const StageTimer&) = delete;
 
@@ -47,12 +49,18 @@ void deskew_selection(const Scan& scan, std::span<const float> times, std::span<
 
 const char* stage_name(Stage stage) {
   switch (stage) {
-    case Stage::kRangeImage: return "range_image";
-    case Stage::kSegmentation: return "segmentation";
-    case Stage::kFeatures: return "features";
-    case Stage::kDeskew: return "deskew";
-    case Stage::kRegistration: return "registration";
-    case Stage::kMapUpdate: return "map_update";
+    case Stage::kRangeImage:
+      return "range_image";
+    case Stage::kSegmentation:
+      return "segmentation";
+    case Stage::kFeatures:
+      return "features";
+    case Stage::kDeskew:
+      return "deskew";
+    case Stage::kRegistration:
+      return "registration";
+    case Stage::kMapUpdate:
+      return "map_update";
   }
   return "unknown";
 }

@@ -32,7 +32,7 @@ struct FrontEndConfig {
 /// One LiDAR as the odometry sees it.
 struct LidarSetup {
   std::string name;
-  LidarModel model;         ///< vertical_angles_deg may be empty (fallback)
+  LidarModel model;  ///< vertical_angles_deg may be empty (fallback)
   SE3 T_base_lidar;
 };
 

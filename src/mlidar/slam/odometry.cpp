@@ -5,10 +5,11 @@
 #include <limits>
 #include <optional>
 #include <span>
-#include <numbers>
 #include <stdexcept>
 
 #include <tbb/parallel_for.h>
+
+#include "mlidar/core/conversions.hpp"
 
 namespace mlidar::slam {
 namespace {
@@ -40,10 +41,14 @@ double mean_point_time(const Frame& frame) {
 void append_features(const LidarFeatures& from, LidarFeatures& to) {
   to.edges.insert(to.edges.end(), from.edges.begin(), from.edges.end());
   to.planes.insert(to.planes.end(), from.planes.begin(), from.planes.end());
-  if (from.edge_times.empty()) to.edge_times.resize(to.edges.size(), 0.0F);
-  else to.edge_times.insert(to.edge_times.end(), from.edge_times.begin(), from.edge_times.end());
-  if (from.plane_times.empty()) to.plane_times.resize(to.planes.size(), 0.0F);
-  else to.plane_times.insert(to.plane_times.end(), from.plane_times.begin(), from.plane_times.end());
+  if (from.edge_times.empty())
+    to.edge_times.resize(to.edges.size(), 0.0F);
+  else
+    to.edge_times.insert(to.edge_times.end(), from.edge_times.begin(), from.edge_times.end());
+  if (from.plane_times.empty())
+    to.plane_times.resize(to.planes.size(), 0.0F);
+  else
+    to.plane_times.insert(to.plane_times.end(), from.plane_times.begin(), from.plane_times.end());
 }
 
 /// Adds the finite values of `values` to sum and count.
@@ -94,8 +99,13 @@ void deskew_again(const BodyVelocity& velocity, LidarFeatures& f) {
 }  // namespace
 
 Odometry::Odometry(OdometryConfig config, std::vector<LidarSetup> lidars)
-    : config_(std::move(config)), lidars_(std::move(lidars)), workspaces_(lidars_.size()), features_(lidars_.size()),
-      edge_map_(config_.edge_voxel_m, config_.edge_points_per_voxel), plane_map_(config_.plane_voxel_m, config_.plane_points_per_voxel) {
+    : config_(std::move(config)),
+      lidars_(std::move(lidars)),
+      workspaces_(lidars_.size()),
+      features_(lidars_.size()),
+      edge_map_(config_.edge_voxel_m, config_.edge_points_per_voxel),
+      plane_map_(config_.plane_voxel_m, config_.plane_points_per_voxel),
+      recent_residuals_(config_.trust.residual_history) {
   if (lidars_.empty()) throw std::invalid_argument("Odometry: no LiDARs");
 }
 
@@ -126,7 +136,7 @@ void Odometry::update_map(const SE3& T_world_centroid, const LidarFeatures& feat
   plane_map_.remove_far(origin, config_.local_map_radius_m);
 }
 
-void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_lost) {
+void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_unmapped) {
   const BodyVelocity velocity = latest_velocity();
   // World so far: the base at the first centroid, whose pose from the first stamp is Exp(t_c v).
   const SE3 T_stamp_centroid = velocity.pose_at(first_centroid_time);
@@ -135,7 +145,7 @@ void Odometry::restart_with_first_velocity(double first_centroid_time, bool seco
   plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);
   deskew_again(velocity, first_features_);
   update_map(centroid_poses_.front().T_world_base, first_features_);
-  if (!second_lost) {
+  if (!second_unmapped) {
     deskew_again(velocity, frame_features_);
     update_map(centroid_poses_.back().T_world_base, frame_features_);
   }
@@ -150,10 +160,7 @@ void Odometry::adapt_threshold(const SE3& prediction, const SE3& estimate) {
   ++error_count_;
 }
 
-bool Odometry::trusted(const RegistrationResult& registration) const {
-  return registration.match_ratio() >= config_.min_match_ratio &&
-         registration.mean_residual_m <= config_.trusted_mean_residual_m;
-}
+TrustRule Odometry::trust_rule() const { return {config_.trust, recent_residuals_.median_m()}; }
 
 void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
   // Eq 4.12 again with the velocity from the previous centroid to this registration: the
@@ -177,34 +184,55 @@ void Odometry::apply_registered_deskew(const BodyVelocity& used, const BodyVeloc
   }
 }
 
-RegistrationResult Odometry::register_robustly(const SE3& prediction, const MotionDeskew* motion, FrameResult& frame) {
-  const double threshold = error_count_ == 0 ? config_.initial_threshold_m
-                                             : std::max(config_.min_threshold_m, 3.0 * std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)));
-  frame.threshold_m = threshold;
-  RegistrationResult best =
-      register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold, config_.registration, motion);
-  if (trusted(best)) return best;
-  frame.retried = true;
-  // Prefer a trusted candidate; among equals, the one whose matches are tighter.
-  const auto better = [this](const RegistrationResult& a, const RegistrationResult& b) {
-    if (trusted(a) != trusted(b)) return trusted(a);
-    return a.mean_residual_m < b.mean_residual_m;
+void Odometry::add_retries(const SE3& prediction, double threshold, const MotionDeskew* motion,
+                           std::vector<RegistrationResult>& out) const {
+  std::vector<SE3> starts;
+  const auto add_turned = [&](const SE3& around) {
+    for (const double yaw_deg : config_.retry_yaw_deg) starts.push_back(around * SE3(so3_exp(Vec3(0, 0, deg_to_rad(yaw_deg))), Vec3::Zero()));
   };
-  for (const double yaw_deg : config_.retry_yaw_deg) {
-    const SE3 turn(so3_exp(Vec3(0, 0, yaw_deg * std::numbers::pi / 180.0)), Vec3::Zero());
-    // A coarse pass with the initial (wide) threshold, then a fine pass.
-    const RegistrationResult coarse = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction * turn,
-                                                           std::max(threshold, config_.initial_threshold_m), config_.registration);
-    RegistrationResult fine = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base,
-                                                   threshold, config_.registration, motion);
-    if (better(fine, best)) best = fine;
-    if (trusted(best)) break;
+  add_turned(prediction);
+  if (config_.retry_from_previous_pose) {
+    starts.push_back(centroid_poses_.back().T_world_base);
+    add_turned(centroid_poses_.back().T_world_base);
   }
-  return best;
+  // Independent of each other (the maps are only read), so in parallel; each lands in its own slot.
+  const std::size_t first = out.size();
+  out.resize(first + starts.size());
+  tbb::parallel_for(std::size_t{0}, starts.size(), [&](std::size_t i) {
+    // A coarse pass with the initial (wide) threshold, then a fine pass.
+    const RegistrationResult coarse = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, starts[i],
+                                                           std::max(threshold, config_.initial_threshold_m), config_.registration);
+    out[first + i] = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base,
+                                          threshold, config_.registration, motion);
+  });
+}
+
+RegistrationResult Odometry::register_robustly(const SE3& prediction, const MotionDeskew* motion, FrameResult& frame) {
+  const double threshold = error_count_ == 0
+                               ? config_.initial_threshold_m
+                               : std::max(config_.min_threshold_m, 3.0 * std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)));
+  frame.threshold_m = threshold;
+  const TrustRule rule = trust_rule();
+  frame.recent_residual_m = rule.recent_median_m;
+  std::vector<RegistrationResult> candidates;
+  candidates.push_back(register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold,
+                                            config_.registration, motion));
+  if (rule.trusted(candidates.front())) {
+    frame.trust = Trust::kTrusted;
+    return std::move(candidates.front());
+  }
+  // Every retry runs (not only up to the first trusted one): the first to pass
+  // may be a wrong alignment that a later start beats, and the rivals say whether the best is unique.
+  frame.retried = true;
+  add_retries(prediction, threshold, motion, candidates);
+  const Choice choice = choose_registration(candidates, rule);
+  frame.trust = choice.trust;
+  return std::move(candidates[choice.best]);
 }
 
 FrameResult Odometry::process(const Frame& frame) {
-  if (frame.scans.size() != lidars_.size()) throw std::invalid_argument("Odometry::process: frame has a different number of scans than LiDARs");
+  if (frame.scans.size() != lidars_.size())
+    throw std::invalid_argument("Odometry::process: frame has a different number of scans than LiDARs");
   FrameResult result;
   result.stamp = frame.stamp;
   result.centroid_time = mean_point_time(frame);
@@ -239,13 +267,14 @@ FrameResult Odometry::process(const Frame& frame) {
     result.registration = register_robustly(prediction, motion ? &*motion : nullptr, result);
     const BodyVelocity deskewed_with = result.registration.velocity_used.value_or(velocity);
     if (result.registration.velocity_used) apply_registered_deskew(velocity, deskewed_with);
-    if (config_.refine_deskew && centroid_poses_.size() >= 2 && trusted(result.registration)) refine_deskew(deskewed_with, centroid_stamp, result);
+    if (config_.refine_deskew && centroid_poses_.size() >= 2 && result.trust == Trust::kTrusted)
+      refine_deskew(deskewed_with, centroid_stamp, result);
     T_world_centroid = result.registration.T_world_base;
-    result.lost = result.registration.match_ratio() < config_.lost_match_ratio ||
-                  result.registration.mean_residual_m > config_.trusted_mean_residual_m;
     result.lidar_mean_residual_m = mean_residual_per_lidar(features_, result.registration.residuals_m);
-    if (result.lost) T_world_centroid = prediction;  // flagged, not silently trusted
-    else if ((prediction.inverse() * centroid_poses_.back().T_world_base).translation().norm() >= config_.min_motion_m)
+    if (result.lost())
+      T_world_centroid = prediction;  // flagged, not silently trusted
+    else if (result.trust == Trust::kTrusted &&
+             (prediction.inverse() * centroid_poses_.back().T_world_base).translation().norm() >= config_.min_motion_m)
       adapt_threshold(prediction, T_world_centroid);
   }
   result.seconds[static_cast<std::size_t>(Stage::kRegistration)] += seconds_since(start);
@@ -258,11 +287,14 @@ FrameResult Odometry::process(const Frame& frame) {
   }
   centroid_poses_.push_back({centroid_stamp, T_world_centroid});
   if (centroid_poses_.size() == 2) {
-    restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.lost);
+    restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.flagged());
     result.registration.T_world_base = centroid_poses_.back().T_world_base;
-  } else if (!result.lost) {
+  } else if (result.trust == Trust::kTrusted) {
     update_map(T_world_centroid, frame_features_);
   }
+  // Every registered frame, suspect ones too: a lasting change of the fit (a rougher scene) moves the
+  // median within half the history instead of leaving every later frame suspect and the map frozen.
+  if (centroid_poses_.size() >= 2 && !result.lost()) recent_residuals_.add(result.registration.mean_residual_m);
   result.seconds[static_cast<std::size_t>(Stage::kMapUpdate)] += seconds_since(start);
   result.T_world_base = centroid_poses_.back().T_world_base * latest_velocity().pose_at(-result.centroid_time);
   return result;

@@ -6,9 +6,12 @@
 //      to the frame's time centroid t_c (mean capture time of its points);
 //   3. register all LiDARs' features at once against the local maps;
 //      when the match ratio is poor, retry from several yaw offsets
-//      (large unmodelled turns) and keep the best; flag the frame lost if
-//      none matches well;
-//   4. add the features to the voxel-hashed local maps, drop far voxels;
+//      (large unmodelled turns) and from the previous pose, and keep the
+//      tightest; flag the frame lost if none matches well, suspect if the
+//      tightest still fits worse than the recent frames or another
+//      alignment fits as well (registration_trust.hpp);
+//   4. add the features of a trusted frame to the voxel-hashed local maps
+//      (never a suspect or lost one's), drop far voxels;
 //   5. adapt the correspondence threshold from the prediction error
 //      (KISS-ICP's adaptive threshold, Vizzo et al. 2023, eq 6-7);
 //   6. report T_world_base at the frame stamp: the registered pose at t_c
@@ -28,6 +31,7 @@
 #include <vector>
 
 #include "mlidar/slam/frontend.hpp"
+#include "mlidar/slam/registration_trust.hpp"
 #include "mlidar/slam/scan_to_map.hpp"
 #include "mlidar/slam/voxel_map.hpp"
 
@@ -41,18 +45,21 @@ struct OdometryConfig {
   int plane_points_per_voxel = 20;
   int edge_points_per_voxel = 10;
   double local_map_radius_m = 100.0;
-  double initial_threshold_m = 2.0;   ///< correspondence distance before any motion is seen
+  double initial_threshold_m = 2.0;  ///< correspondence distance before any motion is seen
   double min_threshold_m = 0.3;
-  double min_motion_m = 0.1;          ///< predictions moving less are not used to adapt
-  double reference_range_m = 30.0;    ///< converts rotation error into metres
-  double min_match_ratio = 0.5;       ///< below this the yaw retries run
-  /// A registration is trusted only when its matches are also tight: the adaptive
-  /// threshold grows after hard turns and then lets a wrong alignment match well
-  /// (real BALM keyframes 45->46, a 21 deg turn). Above this mean |r| the yaw
-  /// retries run, and a frame that stays above it is lost.
-  double trusted_mean_residual_m = 0.2;
-  double lost_match_ratio = 0.5;      ///< below this after retries the frame is lost
+  double min_motion_m = 0.1;        ///< predictions moving less are not used to adapt
+  double reference_range_m = 30.0;  ///< converts rotation error into metres
+  /// When a registration is believed (registration_trust.hpp): its absolute
+  /// bounds (mean |r| at most 0.2 m: the adaptive threshold grows after hard
+  /// turns and then lets a wrong alignment match well, real BALM keyframes
+  /// 45->46, a 21 deg turn) and its bound relative to the recent frames.
+  /// Untrusted, the retries run; the best of all is kept and judged.
+  TrustConfig trust;
   std::vector<double> retry_yaw_deg = {15, -15, 30, -30, 45, -45, 60, -60};
+  /// The retries also start from the previous pose (no motion), turned by the
+  /// same yaws: after a second of handheld motion the constant-velocity
+  /// prediction can be metres off.
+  bool retry_from_previous_pose = true;
   /// After a trusted registration, deskew the frame's features again with the
   /// velocity it measured (the prediction's is a frame late) and register once
   /// more from there, before they enter the map. Off: it costs a second
@@ -77,7 +84,14 @@ struct FrameResult {
   std::size_t plane_features = 0;
   double threshold_m = 0.0;
   bool retried = false;
-  bool lost = false;
+  Trust trust = Trust::kTrusted;
+  double recent_residual_m = 0.0;  ///< the recent frames' median mean |r| it was judged against (NaN: none)
+  /// No acceptable registration: the pose is the prediction, not mapped.
+  bool lost() const { return trust == Trust::kLost; }
+  /// Acceptable but not trusted (`trust` says why): the pose is kept, not mapped.
+  bool suspect() const { return trust == Trust::kResidual || trust == Trust::kAmbiguous; }
+  /// Lost or suspect: its pose must not feed a calibration, a window or a map.
+  bool flagged() const { return lost() || suspect(); }
   /// Per LiDAR (construction order): mean |r| of its matched features at the
   /// registration's last linearisation; NaN when it matched none (and on the first frame).
   std::vector<double> lidar_mean_residual_m;
@@ -109,14 +123,16 @@ class Odometry {
   RegistrationResult register_robustly(const SE3& prediction, const MotionDeskew* motion, FrameResult& frame);
   /// After a registration with MotionDeskew: the frame's features deskewed with the velocity it ended with.
   void apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered);
-  bool trusted(const RegistrationResult& registration) const;
+  TrustRule trust_rule() const;
+  /// Registrations from the retry starts (prediction and previous pose, turned).
+  void add_retries(const SE3& prediction, double threshold, const MotionDeskew* motion, std::vector<RegistrationResult>& out) const;
   void refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result);
   void adapt_threshold(const SE3& prediction, const SE3& estimate);
   void update_map(const SE3& T_world_centroid, const LidarFeatures& features);
   /// At the second frame, once a velocity is known: moves the world from the
   /// first frame's centroid pose to its stamp pose and rebuilds the map from
   /// the first two frames' features deskewed with that velocity.
-  void restart_with_first_velocity(double first_centroid_time, bool second_lost);
+  void restart_with_first_velocity(double first_centroid_time, bool second_unmapped);
 
   OdometryConfig config_;
   std::vector<LidarSetup> lidars_;
@@ -127,6 +143,7 @@ class Odometry {
   VoxelMap edge_map_;
   VoxelMap plane_map_;
   std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid
+  ResidualHistory recent_residuals_;  ///< mean |r| of the last registered (not lost) frames
   double first_stamp_ = 0.0;
   double error_sq_sum_ = 0.0;
   std::size_t error_count_ = 0;

@@ -17,7 +17,9 @@ void add_to_map(const SE3& T_world_base, const std::vector<Eigen::Vector3f>& poi
 }  // namespace
 
 OdometryWindow::OdometryWindow(OdometryWindowConfig config, VoxelMap edge_map, VoxelMap plane_map)
-    : config_(std::move(config)), edge_map_(std::move(edge_map)), plane_map_(std::move(plane_map)),
+    : config_(std::move(config)),
+      edge_map_(std::move(edge_map)),
+      plane_map_(std::move(plane_map)),
       state_(WindowState::make({}, {SE3::identity()}, 0, false)) {
   if (config_.size < 1 || config_.pivot < 1 || config_.pivot > config_.size)
     throw std::invalid_argument("OdometryWindow: expected size >= 1 and 1 <= pivot <= size");
@@ -27,7 +29,8 @@ OdometryWindowUpdate OdometryWindow::add(std::size_t frame, LidarFrameFeatures f
                                          const SE3& T_estimate_output) {
   // Start from the window's previous estimate moved by the odometry's relative motion.
   SE3 initial = T_world_base_odometry;
-  if (last_odometry_pose_ && !entries_.empty()) initial = state_.T_world_base.back() * (last_odometry_pose_->inverse() * T_world_base_odometry);
+  if (last_odometry_pose_ && !entries_.empty())
+    initial = state_.T_world_base.back() * (last_odometry_pose_->inverse() * T_world_base_odometry);
   last_odometry_pose_ = T_world_base_odometry;
 
   OdometryWindowUpdate update;
@@ -86,7 +89,8 @@ std::size_t OdometryWindow::solve() {
   const MapView map{edge_map_, plane_map_, config_.registration};
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     if (state_.pose_fixed[i]) continue;
-    const MapFit fit = add_map_correspondences(entries_[i].features, static_cast<int>(i), 0, state_.T_world_base[i], map, config_.gate_m, problem_);
+    const MapFit fit =
+        add_map_correspondences(entries_[i].features, static_cast<int>(i), 0, state_.T_world_base[i], map, config_.gate_m, problem_);
     if (fit.planes + fit.edges < static_cast<std::size_t>(config_.min_correspondences)) {
       problem_.planes.clear();
       problem_.edges.clear();

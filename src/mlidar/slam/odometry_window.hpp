@@ -32,9 +32,9 @@
 namespace mlidar::slam {
 
 struct OdometryWindowConfig {
-  int size = 4;   ///< N: the window holds N + 1 frames
-  int pivot = 2;  ///< p: frames 0..p-1 of the window are fixed (1 <= p <= N)
-  double gate_m = 0.5;  ///< correspondence gate on |r| (m)
+  int size = 4;                  ///< N: the window holds N + 1 frames
+  int pivot = 2;                 ///< p: frames 0..p-1 of the window are fixed (1 <= p <= N)
+  double gate_m = 0.5;           ///< correspondence gate on |r| (m)
   int min_correspondences = 30;  ///< per variable frame; fewer: the window is not solved
   double plane_voxel_m = 1.0;
   double edge_voxel_m = 1.0;
@@ -52,10 +52,10 @@ struct WindowPose {
 };
 
 struct OdometryWindowUpdate {
-  WindowPose latest;                ///< the frame just added, as the window now estimates it
+  WindowPose latest;                  ///< the frame just added, as the window now estimates it
   std::optional<WindowPose> settled;  ///< the frame that left the variable part (its final pose)
-  std::size_t correspondences = 0;  ///< of the last solve (0: not solved)
-  int prior_rank = 0;               ///< rows of the marginalization prior now in the window
+  std::size_t correspondences = 0;    ///< of the last solve (0: not solved)
+  int prior_rank = 0;                 ///< rows of the marginalization prior now in the window
 };
 
 class OdometryWindow {
@@ -69,8 +69,7 @@ class OdometryWindow {
   /// `T_world_base_odometry` given by the odometry; `T_estimate_output` takes
   /// the estimated pose to the reported one (e.g. from the time centroid to
   /// the stamp). Frames in increasing order.
-  OdometryWindowUpdate add(std::size_t frame, LidarFrameFeatures features, const SE3& T_world_base_odometry,
-                           const SE3& T_estimate_output);
+  OdometryWindowUpdate add(std::size_t frame, LidarFrameFeatures features, const SE3& T_world_base_odometry, const SE3& T_estimate_output);
 
   /// The current estimates of the frames not settled yet (oldest first).
   std::vector<WindowPose> unsettled() const;

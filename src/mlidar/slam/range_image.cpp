@@ -38,8 +38,8 @@ double fast_atan2(double y, double x) {
   return std::signbit(y) ? -angle : angle;
 }
 
-void build_range_image(std::span<const Eigen::Vector3f> points, std::span<const std::uint16_t> ring,
-                       const LidarModel& model, RangeImage& image) {
+void build_range_image(std::span<const Eigen::Vector3f> points, std::span<const std::uint16_t> ring, const LidarModel& model,
+                       RangeImage& image) {
   if (model.vertical_angles_deg.empty() || !(model.horizontal_resolution_deg > 0.0))
     throw std::invalid_argument("build_range_image: model '" + model.name + "' has no vertical angles or resolution");
   if (!ring.empty() && ring.size() != points.size()) throw std::invalid_argument("build_range_image: ring size differs from points");

@@ -19,10 +19,12 @@ struct RangeImage {
   static constexpr std::int32_t kEmpty = -1;
   int rows = 0;
   int cols = 0;
-  std::vector<float> range;          ///< metres, 0 where empty
-  std::vector<std::int32_t> index;   ///< point index into the scan, or kEmpty
+  std::vector<float> range;         ///< metres, 0 where empty
+  std::vector<std::int32_t> index;  ///< point index into the scan, or kEmpty
 
-  std::size_t pixel(int row, int col) const { return static_cast<std::size_t>(row) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(col); }
+  std::size_t pixel(int row, int col) const {
+    return static_cast<std::size_t>(row) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(col);
+  }
 };
 
 /// Row of the table angle nearest to elevation_deg; table sorted ascending, non-empty.
@@ -40,7 +42,7 @@ double fast_atan2(double y, double x);
 /// points share a pixel the nearer one is kept. `image` is reused (no
 /// allocation once its buffers are large enough).
 /// Throws std::invalid_argument for a model without angles or sizes that differ.
-void build_range_image(std::span<const Eigen::Vector3f> points, std::span<const std::uint16_t> ring,
-                       const LidarModel& model, RangeImage& image);
+void build_range_image(std::span<const Eigen::Vector3f> points, std::span<const std::uint16_t> ring, const LidarModel& model,
+                       RangeImage& image);
 
 }  // namespace mlidar::slam

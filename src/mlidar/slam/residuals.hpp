@@ -32,7 +32,7 @@ void plane_residual(const PlaneCoefficients& plane, const Vec3& q_world, Vec3& r
 /// a = w^T q + d and j = [w^T, (q x w)^T]: the same normal equations at a
 /// third of the cost (what scan-to-map registration accumulates).
 struct PlaneRow {
-  double residual = 0.0;       ///< a, signed distance
+  double residual = 0.0;         ///< a, signed distance
   Vec6 jacobian = Vec6::Zero();  ///< j^T
 };
 PlaneRow plane_row(const PlaneCoefficients& plane, const Vec3& q_world);

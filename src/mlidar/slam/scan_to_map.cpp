@@ -5,9 +5,9 @@
 #include <optional>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
+#include <Eigen/Eigenvalues>
 
 #include "mlidar/slam/map_matcher.hpp"
 #include "mlidar/slam/residuals.hpp"
@@ -29,8 +29,11 @@ struct NormalEquations {
     g.noalias() += (w * row.residual) * row.jacobian;
   }
   NormalEquations& operator+=(const NormalEquations& o) {
-    H += o.H; g += o.g;
-    residual_sum += o.residual_sum; planes += o.planes; edges += o.edges;
+    H += o.H;
+    g += o.g;
+    residual_sum += o.residual_sum;
+    planes += o.planes;
+    edges += o.edges;
     return *this;
   }
 };
@@ -56,11 +59,11 @@ struct Matcher {
   const VoxelMap& plane_map;
   const SE3& T;
   const RegistrationConfig& config;
-  float neighborhood_sq;    ///< squared search radius for the map neighbours
-  double max_residual_m;    ///< correspondences with a larger |r| are rejected
+  float neighborhood_sq;  ///< squared search radius for the map neighbours
+  double max_residual_m;  ///< correspondences with a larger |r| are rejected
   double huber_delta;
-  double rematch_sq;        ///< squared rematch distance
-  MatchCache& cache;        ///< each feature's entry is touched by one task only
+  double rematch_sq;           ///< squared rematch distance
+  MatchCache& cache;           ///< each feature's entry is touched by one task only
   std::span<float> residuals;  ///< |r| per query (edges, then planes), NaN when unmatched
 
   template <typename Model, typename Search>
@@ -109,7 +112,7 @@ struct Matcher {
 
 NormalEquations linearise(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const Matcher& matcher) {
   const std::size_t total = edges.size() + planes.size();
-  return tbb::parallel_reduce(
+  return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, total, 256), NormalEquations{},
       [&](const tbb::blocked_range<std::size_t>& range, NormalEquations eq) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -136,6 +139,7 @@ void keep_initial_along_weak_translation(const SE3& initial, double threshold, R
   if (!result.degenerate) return;
   Vec6 correction = (result.T_world_base * initial.inverse()).log();
   const Vec3 weak = translation.eigenvectors().col(0);
+  result.weak_translation = weak;
   correction.head<3>() -= weak * weak.dot(correction.head<3>());
   result.T_world_base = SE3::exp(correction) * initial;
 }
@@ -163,7 +167,8 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_i
   MatchCache cache{std::vector<CachedMatch<MapLine>>(edges_base.size()), std::vector<CachedMatch<PlaneCoefficients>>(planes_base.size())};
   for (int iteration = 0; iteration < config.max_iterations; ++iteration) {
     const double rematch_sq = config.rematch_distance_m * config.rematch_distance_m;
-    const Matcher matcher{edge_map, plane_map, result.T_world_base, config, neighborhood_sq, max_correspondence_m, config.huber_delta_m, rematch_sq, cache, result.residuals_m};
+    const Matcher matcher{edge_map,   plane_map, result.T_world_base, config, neighborhood_sq, max_correspondence_m, config.huber_delta_m,
+                          rematch_sq, cache,     result.residuals_m};
     const NormalEquations eq = linearise(edges_base, planes_base, matcher);
     result.iterations = iteration + 1;
     result.plane_matches = eq.planes;

@@ -13,12 +13,10 @@
 // edge_linearity x the middle one and every neighbour lies within
 // edge_tolerance of the line); a feature that moved less than
 // rematch_distance_m since its last search keeps its fitted plane or line. Normal equations are summed with
-// tbb::parallel_reduce. Degeneracy (Zhang, Kaess & Singh, ICRA 2016): the
-// translation block of H is sum w n n^T over the residual normals; when the
-// ratio of its smallest to largest eigenvalue (scale-free: independent of the
-// number of points) falls below degeneracy_threshold, the update along the
-// smallest one's eigenvector is dropped (the prediction is kept there) and
-// the result says so.
+// tbb::parallel_deterministic_reduce (fixed chunks: the same sums whatever the thread count). Degeneracy (Zhang, Kaess & Singh, ICRA 2016):
+// the translation block of H is sum w n n^T over the residual normals; when the ratio of its smallest to largest eigenvalue (scale-free:
+// independent of the number of points) falls below degeneracy_threshold, the update along the smallest one's eigenvector is dropped (the
+// prediction is kept there) and the result says so.
 #include <span>
 #include <vector>
 
@@ -39,10 +37,10 @@ struct RegistrationConfig {
   int neighbors = 5;
   double neighborhood_radius_m = 1.0;  ///< map neighbours are searched at least this far (the map's density, not the pose error)
   double plane_tolerance_m = 0.2;
-  double huber_delta_m = 0.1;       ///< Huber scale on |r| (eq 4.9's rho)
-  double plane_spread = 3.0;        ///< a plane needs middle eigenvalue >= this x smallest
+  double huber_delta_m = 0.1;  ///< Huber scale on |r| (eq 4.9's rho)
+  double plane_spread = 3.0;   ///< a plane needs middle eigenvalue >= this x smallest
   double edge_linearity = 10.0;
-  double edge_tolerance_m = 0.1;    ///< every edge neighbour within this of the fitted line
+  double edge_tolerance_m = 0.1;  ///< every edge neighbour within this of the fitted line
   /// Measured (rv rig, 40 frames each): campus 0.19-0.35, corridor 0.03-0.05.
   double degeneracy_threshold = 0.1;
   /// A feature's map neighbours are searched again only after it moved this far
@@ -58,17 +56,21 @@ struct RegistrationResult {
   std::size_t queries = 0;
   std::size_t plane_matches = 0;
   std::size_t edge_matches = 0;
-  double mean_residual_m = 0.0;     ///< mean |r| over matches at the last linearisation
-  Mat6 hessian = Mat6::Zero();      ///< J^T W J at the solution, [t, r] order
-  Vec6 eigenvalues = Vec6::Zero();  ///< of hessian, ascending
+  double mean_residual_m = 0.0;            ///< mean |r| over matches at the last linearisation
+  Mat6 hessian = Mat6::Zero();             ///< J^T W J at the solution, [t, r] order
+  Vec6 eigenvalues = Vec6::Zero();         ///< of hessian, ascending
   double translation_observability = 0.0;  ///< lambda_min(H_tt) / lambda_max(H_tt), in [0, 1]
   bool degenerate = false;
+  /// When degenerate: the unit translation (world frame) left at its initial value; zero otherwise.
+  Vec3 weak_translation = Vec3::Zero();
   /// |r| of each query (edges, then planes, in the order given) at the last
   /// linearisation; NaN where it had no correspondence within the gate.
   std::vector<float> residuals_m;
   std::optional<BodyVelocity> velocity_used;  ///< with MotionDeskew: the features' final deskew velocity
 
-  double match_ratio() const { return queries == 0 ? 0.0 : static_cast<double>(plane_matches + edge_matches) / static_cast<double>(queries); }
+  double match_ratio() const {
+    return queries == 0 ? 0.0 : static_cast<double>(plane_matches + edge_matches) / static_cast<double>(queries);
+  }
 };
 
 /// Deskew inside the registration: the features were deskewed (eq 4.12) with

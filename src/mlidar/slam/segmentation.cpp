@@ -43,9 +43,8 @@ bool same_object(float range_a, float range_b, double sin_step, double cos_step,
 
 }  // namespace
 
-void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3f> points,
-                         std::span<const double> sorted_angles_deg, const Eigen::Vector3f& up_lidar,
-                         const SegmentationConfig& config, Segmentation& out) {
+void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3f> points, std::span<const double> sorted_angles_deg,
+                         const Eigen::Vector3f& up_lidar, const SegmentationConfig& config, Segmentation& out) {
   if (sorted_angles_deg.size() != static_cast<std::size_t>(image.rows))
     throw std::invalid_argument("segment_range_image: angle table size differs from image rows");
   const std::size_t pixels = image.index.size();
@@ -75,7 +74,8 @@ void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3
       const int col = static_cast<int>(p % static_cast<std::size_t>(image.cols));
       min_row = std::min(min_row, row);
       max_row = std::max(max_row, row);
-      const int neighbours[4][2] = {{row, (col + 1) % image.cols}, {row, (col + image.cols - 1) % image.cols}, {row - 1, col}, {row + 1, col}};
+      const int neighbours[4][2] = {
+          {row, (col + 1) % image.cols}, {row, (col + image.cols - 1) % image.cols}, {row - 1, col}, {row + 1, col}};
       for (const auto& [nrow, ncol] : neighbours) {
         if (nrow < 0 || nrow >= image.rows) continue;
         const std::size_t q = image.pixel(nrow, ncol);
@@ -83,7 +83,8 @@ void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3
         double sin_step = sin_h;
         double cos_step = cos_h;
         if (nrow != row) {
-          const double v_step = std::abs(sorted_angles_deg[static_cast<std::size_t>(nrow)] - sorted_angles_deg[static_cast<std::size_t>(row)]) * kRadians;
+          const double v_step =
+              std::abs(sorted_angles_deg[static_cast<std::size_t>(nrow)] - sorted_angles_deg[static_cast<std::size_t>(row)]) * kRadians;
           sin_step = std::sin(v_step);
           cos_step = std::cos(v_step);
         }

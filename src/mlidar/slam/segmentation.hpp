@@ -27,11 +27,11 @@ struct SegmentationConfig {
 
 /// Per-pixel labels of one range image.
 struct Segmentation {
-  static constexpr std::int32_t kNone = -1;   ///< empty pixel or dropped cluster
+  static constexpr std::int32_t kNone = -1;  ///< empty pixel or dropped cluster
   static constexpr std::int32_t kGround = 0;
-  std::vector<std::int32_t> label;            ///< kNone, kGround or cluster id >= 1
-  int clusters = 0;                           ///< clusters kept
-  std::vector<std::uint32_t> queue;           ///< breadth-first workspace, reused
+  std::vector<std::int32_t> label;   ///< kNone, kGround or cluster id >= 1
+  int clusters = 0;                  ///< clusters kept
+  std::vector<std::uint32_t> queue;  ///< breadth-first workspace, reused
 
   bool kept(std::size_t pixel) const { return label[pixel] != kNone; }
 };
@@ -40,8 +40,7 @@ struct Segmentation {
 /// unit up direction in the LiDAR frame) then grows clusters over the rest.
 /// `points` are the points the image indexes; `sorted_angles_deg` the model's
 /// vertical angles ascending (row order). `out` is reused between calls.
-void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3f> points,
-                         std::span<const double> sorted_angles_deg, const Eigen::Vector3f& up_lidar,
-                         const SegmentationConfig& config, Segmentation& out);
+void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3f> points, std::span<const double> sorted_angles_deg,
+                         const Eigen::Vector3f& up_lidar, const SegmentationConfig& config, Segmentation& out);
 
 }  // namespace mlidar::slam

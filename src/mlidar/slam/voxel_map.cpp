@@ -6,7 +6,8 @@
 namespace mlidar::slam {
 
 VoxelMap::VoxelMap(double voxel_size, int max_points_per_voxel) : voxel_size_(voxel_size), max_points_(max_points_per_voxel) {
-  if (!(voxel_size > 0.0) || max_points_per_voxel < 1) throw std::invalid_argument("VoxelMap: voxel_size must be > 0 and max_points_per_voxel >= 1");
+  if (!(voxel_size > 0.0) || max_points_per_voxel < 1)
+    throw std::invalid_argument("VoxelMap: voxel_size must be > 0 and max_points_per_voxel >= 1");
 }
 
 VoxelKey VoxelMap::key_of(const Eigen::Vector3f& p) const {
@@ -62,7 +63,9 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
   // the distance to the voxel's box, shrunk a little against rounding).
   const double inv = 1.0 / voxel_size_;
   const auto size = static_cast<float>(voxel_size_);
-  const auto fraction_of = [inv](float coordinate, std::int32_t cell) { return static_cast<float>(static_cast<double>(coordinate) * inv - cell); };
+  const auto fraction_of = [inv](float coordinate, std::int32_t cell) {
+    return static_cast<float>(static_cast<double>(coordinate) * inv - cell);
+  };
   const Eigen::Vector3f fraction(fraction_of(q.x(), center.x), fraction_of(q.y(), center.y), fraction_of(q.z(), center.z));
   std::array<NearbyVoxel, 27> order{};
   int voxels = 0;
@@ -78,7 +81,8 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
           order[static_cast<std::size_t>(slot)] = order[static_cast<std::size_t>(slot - 1)];
           --slot;
         }
-        order[static_cast<std::size_t>(slot)] = {bound, static_cast<std::int8_t>(dx), static_cast<std::int8_t>(dy), static_cast<std::int8_t>(dz)};
+        order[static_cast<std::size_t>(slot)] = {bound, static_cast<std::int8_t>(dx), static_cast<std::int8_t>(dy),
+                                                 static_cast<std::int8_t>(dz)};
       }
     }
   }

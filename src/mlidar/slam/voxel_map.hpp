@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
-#include <Eigen/Core>
 #include <tsl/robin_map.h>
+#include <Eigen/Core>
 
 namespace mlidar::slam {
 

@@ -18,8 +18,10 @@ struct PairTransform {
   Vec3 t_base_lidar;
 
   PairTransform(const SE3& T_world_base, const SE3& T_base_lidar)
-      : R_world_base(T_world_base.rotation_matrix()), t_world_base(T_world_base.translation()),
-        R_base_lidar(T_base_lidar.rotation_matrix()), t_base_lidar(T_base_lidar.translation()) {}
+      : R_world_base(T_world_base.rotation_matrix()),
+        t_world_base(T_world_base.translation()),
+        R_base_lidar(T_base_lidar.rotation_matrix()),
+        t_base_lidar(T_base_lidar.translation()) {}
 };
 
 /// One row s = n^T q + offset with its pose and extrinsic gradients.
@@ -88,7 +90,7 @@ PairSums reduce_rows(const WindowProblem& problem, const WindowState& state, std
   for (const SE3& T_world_base : state.T_world_base)
     for (const SE3& T_base_lidar : state.T_base_lidar) transforms.emplace_back(T_world_base, T_base_lidar);
   const std::size_t total = problem.planes.size() + problem.edges.size();
-  return tbb::parallel_reduce(
+  return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, total, 512), PairSums(pairs),
       [&](const tbb::blocked_range<std::size_t>& range, PairSums sums) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {

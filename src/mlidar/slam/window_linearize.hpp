@@ -31,13 +31,13 @@ using Vec12 = Eigen::Matrix<double, 12, 1>;
 
 /// Scalar rows of one residual at the current estimate.
 struct ResidualRows {
-  int count = 0;                         ///< 1 (plane) or 2 (edge)
-  std::array<Vec3, 2> directions;        ///< n_k, orthonormal, world frame
-  std::array<double, 2> values{};        ///< s_k, metres
-  std::array<Vec12, 2> gradients;        ///< [ds/d(pose), ds/d(extrinsic)]
+  int count = 0;                   ///< 1 (plane) or 2 (edge)
+  std::array<Vec3, 2> directions;  ///< n_k, orthonormal, world frame
+  std::array<double, 2> values{};  ///< s_k, metres
+  std::array<Vec12, 2> gradients;  ///< [ds/d(pose), ds/d(extrinsic)]
 
-  Vec3 residual() const;                 ///< r = sum n_k s_k
-  double squared_norm() const;           ///< |r|^2
+  Vec3 residual() const;        ///< r = sum n_k s_k
+  double squared_norm() const;  ///< |r|^2
 };
 
 ResidualRows plane_rows(const PlaneCorrespondence& c, const SE3& T_world_base, const SE3& T_base_lidar);
@@ -48,14 +48,15 @@ double huber_loss(double squared_norm, double delta);
 
 /// Normal equations over the layout's variables (fixed blocks are constants).
 struct WindowLinearSystem {
-  Eigen::MatrixXd H;     ///< sum w J^T J (+ J*^T J*), layout.size square
-  Eigen::VectorXd g;     ///< sum w J^T r (+ J*^T (r* + J* dx))
-  double cost = 0.0;     ///< F(X), including the prior when it is included
+  Eigen::MatrixXd H;  ///< sum w J^T J (+ J*^T J*), layout.size square
+  Eigen::VectorXd g;  ///< sum w J^T r (+ J*^T (r* + J* dx))
+  double cost = 0.0;  ///< F(X), including the prior when it is included
 };
 
 enum class PriorTerm { kInclude, kExclude };
 
-/// Normal equations at `state`, summed over correspondences with tbb::parallel_reduce.
+/// Normal equations at `state`, summed over correspondences with tbb::parallel_deterministic_reduce (fixed chunks:
+/// the same sums whatever the thread count).
 WindowLinearSystem linearize_window(const WindowProblem& problem, const WindowState& state, const VariableLayout& layout,
                                     double huber_delta, PriorTerm prior = PriorTerm::kInclude);
 /// F(X) alone (cheaper: no Jacobians).

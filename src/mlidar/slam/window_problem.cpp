@@ -17,17 +17,17 @@ WindowState WindowState::make(std::vector<SE3> poses, std::vector<SE3> extrinsic
 
 const SE3& WindowState::value(VariableId id) const {
   return id.kind == VariableId::Kind::kPose ? T_world_base.at(static_cast<std::size_t>(id.index))
-                                             : T_base_lidar.at(static_cast<std::size_t>(id.index));
+                                            : T_base_lidar.at(static_cast<std::size_t>(id.index));
 }
 
 SE3& WindowState::value(VariableId id) {
   return id.kind == VariableId::Kind::kPose ? T_world_base.at(static_cast<std::size_t>(id.index))
-                                             : T_base_lidar.at(static_cast<std::size_t>(id.index));
+                                            : T_base_lidar.at(static_cast<std::size_t>(id.index));
 }
 
 bool WindowState::fixed(VariableId id) const {
   return id.kind == VariableId::Kind::kPose ? pose_fixed.at(static_cast<std::size_t>(id.index))
-                                             : extrinsic_fixed.at(static_cast<std::size_t>(id.index));
+                                            : extrinsic_fixed.at(static_cast<std::size_t>(id.index));
 }
 
 void set_extrinsic_mode(WindowState& state, ExtrinsicMode mode) {
@@ -66,8 +66,8 @@ void check_indices(const std::vector<Correspondence>& list, const WindowState& s
   for (const Correspondence& c : list)
     require(c.frame >= 0 && static_cast<std::size_t>(c.frame) < state.T_world_base.size() && c.lidar >= 0 &&
                 static_cast<std::size_t>(c.lidar) < state.T_base_lidar.size(),
-            std::string(kind) + " correspondence with frame " + std::to_string(c.frame) + " / lidar " +
-                std::to_string(c.lidar) + " outside the window");
+            std::string(kind) + " correspondence with frame " + std::to_string(c.frame) + " / lidar " + std::to_string(c.lidar) +
+                " outside the window");
 }
 
 }  // namespace
@@ -80,8 +80,7 @@ void check_problem(const WindowProblem& problem, const WindowState& state) {
   check_indices(problem.edges, state, "edge");
   const LinearPrior& prior = problem.prior;
   require(prior.linearization_points.size() == prior.variables.size(), "prior linearization points differ from its variables");
-  require(prior.jacobian.cols() == static_cast<Eigen::Index>(6 * prior.variables.size()) &&
-              prior.jacobian.rows() == prior.residual.size(),
+  require(prior.jacobian.cols() == static_cast<Eigen::Index>(6 * prior.variables.size()) && prior.jacobian.rows() == prior.residual.size(),
           "prior Jacobian size");
   for (const VariableId& id : prior.variables) {
     const std::size_t count = id.kind == VariableId::Kind::kPose ? state.T_world_base.size() : state.T_base_lidar.size();

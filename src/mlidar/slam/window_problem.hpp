@@ -33,9 +33,9 @@ struct VariableId {
 
 /// The window's estimates and which of them are held fixed.
 struct WindowState {
-  std::vector<SE3> T_world_base;   ///< pose of the base frame at frame i, i = 0..N (oldest first)
-  std::vector<SE3> T_base_lidar;   ///< LiDAR j in the base frame, j = 0..L-1
-  std::vector<bool> pose_fixed;    ///< same size as T_world_base
+  std::vector<SE3> T_world_base;      ///< pose of the base frame at frame i, i = 0..N (oldest first)
+  std::vector<SE3> T_base_lidar;      ///< LiDAR j in the base frame, j = 0..L-1
+  std::vector<bool> pose_fixed;       ///< same size as T_world_base
   std::vector<bool> extrinsic_fixed;  ///< same size as T_base_lidar; [0] must be true
 
   /// poses.size() poses of which the first `fixed_poses` are held fixed; the
@@ -73,10 +73,10 @@ struct EdgeCorrespondence {
 /// variables from their linearization points X0_k. J* is never re-linearized
 /// (first-estimate Jacobians); J*^T J* = Lambda*_rr, J*^T r* = g*_r (eq 4.41).
 struct LinearPrior {
-  std::vector<VariableId> variables;       ///< 6-column blocks of J*, in order
-  std::vector<SE3> linearization_points;   ///< X0_k, one per variable
-  Eigen::MatrixXd jacobian;                ///< J*: rank x 6 * variables.size()
-  Eigen::VectorXd residual;                ///< r*: rank
+  std::vector<VariableId> variables;      ///< 6-column blocks of J*, in order
+  std::vector<SE3> linearization_points;  ///< X0_k, one per variable
+  Eigen::MatrixXd jacobian;               ///< J*: rank x 6 * variables.size()
+  Eigen::VectorXd residual;               ///< r*: rank
 };
 
 /// The window's cost terms (eq 4.20): map residuals f_M and the prior r_pri.

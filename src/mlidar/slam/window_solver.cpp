@@ -42,9 +42,8 @@ void fill_uncertainty(const WindowProblem& problem, const VariableLayout& layout
   const bool calibrating = std::any_of(layout.extrinsic_offset.begin(), layout.extrinsic_offset.end(), [](int o) { return o >= 0; });
   if (!calibrating) return;
   // Algorithm 1 reads f_M's information: the prior's part is taken out again.
-  const Eigen::MatrixXd map_H = problem.prior.variables.empty()
-                                    ? full.H
-                                    : linearize_window(problem, state, layout, huber_delta, PriorTerm::kExclude).H;
+  const Eigen::MatrixXd map_H =
+      problem.prior.variables.empty() ? full.H : linearize_window(problem, state, layout, huber_delta, PriorTerm::kExclude).H;
   for (std::size_t j = 0; j < state.T_base_lidar.size(); ++j)
     if (layout.extrinsic_offset[j] >= 0) solution.extrinsic_information[j] = schur_onto_block(map_H, layout.extrinsic_offset[j]);
 }

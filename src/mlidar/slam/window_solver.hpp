@@ -13,11 +13,11 @@
 namespace mlidar::slam {
 
 struct WindowSolverConfig {
-  int max_iterations = 10;       ///< accepted steps (each one re-linearizes)
-  double huber_delta_m = 0.1;    ///< Huber scale on |r|, metres
-  double initial_lambda = 1e-6;  ///< Marquardt damping
-  double max_lambda = 1e8;       ///< give up (converged = false) past this
-  double step_tolerance = 1e-10; ///< converged when |dx|_inf (m, rad) falls below
+  int max_iterations = 10;        ///< accepted steps (each one re-linearizes)
+  double huber_delta_m = 0.1;     ///< Huber scale on |r|, metres
+  double initial_lambda = 1e-6;   ///< Marquardt damping
+  double max_lambda = 1e8;        ///< give up (converged = false) past this
+  double step_tolerance = 1e-10;  ///< converged when |dx|_inf (m, rad) falls below
 };
 
 struct WindowSolution {

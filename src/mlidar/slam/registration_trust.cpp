@@ -1,0 +1,79 @@
+#include "mlidar/slam/registration_trust.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "mlidar/core/median.hpp"
+
+namespace mlidar::slam {
+
+const char* trust_name(Trust trust) {
+  switch (trust) {
+    case Trust::kTrusted: return "trusted";
+    case Trust::kResidual: return "residual";
+    case Trust::kAmbiguous: return "ambiguous";
+    case Trust::kLost: return "lost";
+  }
+  return "?";
+}
+
+void ResidualHistory::add(double mean_residual_m) {
+  if (capacity_ == 0 || !std::isfinite(mean_residual_m)) return;
+  values_.push_back(mean_residual_m);
+  if (values_.size() > capacity_) values_.pop_front();
+}
+
+double ResidualHistory::median_m() const {
+  if (values_.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return median(std::vector<double>(values_.begin(), values_.end()));
+}
+
+bool TrustRule::acceptable(const RegistrationResult& r) const {
+  return r.match_ratio() >= config.min_match_ratio && r.mean_residual_m <= config.max_mean_residual_m;
+}
+
+double TrustRule::trusted_limit_m() const {
+  if (!std::isfinite(recent_median_m)) return std::numeric_limits<double>::infinity();
+  return std::max(config.residual_floor_m, config.residual_ratio * recent_median_m);
+}
+
+bool TrustRule::trusted(const RegistrationResult& r) const { return acceptable(r) && r.mean_residual_m <= trusted_limit_m(); }
+
+namespace {
+
+bool distinct(const SE3& a, const SE3& b, const TrustConfig& config) {
+  const SE3 between = a.inverse() * b;
+  const double rotation_deg = so3_log(between.rotation()).norm() * 180.0 / std::numbers::pi;
+  return between.translation().norm() > config.distinct_translation_m || rotation_deg > config.distinct_rotation_deg;
+}
+
+}  // namespace
+
+Choice choose_registration(std::span<const RegistrationResult> candidates, const TrustRule& rule) {
+  if (candidates.empty()) throw std::invalid_argument("choose_registration: no candidates");
+  Choice choice;
+  bool any = false;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!rule.acceptable(candidates[i])) continue;
+    if (!any || candidates[i].mean_residual_m < candidates[choice.best].mean_residual_m) choice.best = i;
+    any = true;
+  }
+  if (!any) return choice;
+  const RegistrationResult& best = candidates[choice.best];
+  choice.trust = rule.trusted(best) ? Trust::kTrusted : Trust::kResidual;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (i == choice.best || !rule.acceptable(candidates[i])) continue;
+    if (candidates[i].mean_residual_m > rule.config.ambiguity_ratio * best.mean_residual_m) continue;
+    if (!distinct(candidates[i].T_world_base, best.T_world_base, rule.config)) continue;
+    choice.trust = Trust::kAmbiguous;
+    choice.rival = i;
+    break;
+  }
+  return choice;
+}
+
+}  // namespace mlidar::slam

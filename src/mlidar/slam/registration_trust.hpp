@@ -1,0 +1,75 @@
+#pragma once
+// When to believe a scan-to-map registration, and which of several to keep.
+// A registration is acceptable when enough of its features matched and its
+// matches are tight in absolute terms; it is trusted when, in addition, its
+// mean |r| is not far above that of the recent registered frames: a wrong
+// alignment of the same kind of scene fits worse than the right ones do (real
+// BALM keyframes 56, 105 and 113: 3.3-3.7 x the recent median, 2.5-3.6 deg
+// off, while every right one lies within 2 x). After retries from several
+// starts the candidate with the tightest matches is kept; it is ambiguous when
+// another one as tight (within ambiguity_ratio) lies elsewhere (BALM
+// keyframes 110 -> 112 at 1 s: two alignments 2.1 m apart, 0.051 and
+// 0.076 m, the first retry to pass was the wrong one).
+#include <cstddef>
+#include <deque>
+#include <optional>
+#include <span>
+
+#include "mlidar/slam/scan_to_map.hpp"
+
+namespace mlidar::slam {
+
+struct TrustConfig {
+  double min_match_ratio = 0.5;           ///< acceptable: at least this share of features matched
+  double max_mean_residual_m = 0.2;       ///< acceptable: mean |r| at most this
+  double residual_ratio = 2.0;            ///< trusted: mean |r| at most this x the recent median ...
+  double residual_floor_m = 0.03;         ///< ... or at most this, whichever is larger
+  std::size_t residual_history = 10;      ///< registered frames the recent median is taken over
+  double ambiguity_ratio = 1.15;          ///< a rival within this x the best's mean |r| ...
+  double distinct_translation_m = 0.2;    ///< ... farther than this ...
+  double distinct_rotation_deg = 2.0;     ///< ... or turned more than this makes the best ambiguous
+};
+
+enum class Trust {
+  kTrusted,    ///< fits like the recent frames; mapped
+  kResidual,   ///< suspect: fits clearly worse than the recent frames
+  kAmbiguous,  ///< suspect: another alignment elsewhere fits as well
+  kLost,       ///< not acceptable at all
+};
+
+const char* trust_name(Trust trust);
+
+/// The median mean |r| of the last registrations.
+class ResidualHistory {
+ public:
+  explicit ResidualHistory(std::size_t capacity) : capacity_(capacity) {}
+  void add(double mean_residual_m);
+  /// NaN before the first.
+  double median_m() const;
+
+ private:
+  std::size_t capacity_;
+  std::deque<double> values_;
+};
+
+struct TrustRule {
+  TrustConfig config;
+  double recent_median_m;  ///< NaN: no history yet (then acceptable is trusted)
+
+  bool acceptable(const RegistrationResult& r) const;
+  bool trusted(const RegistrationResult& r) const;
+  /// The largest mean |r| a trusted registration may have (infinite without history).
+  double trusted_limit_m() const;
+};
+
+struct Choice {
+  std::size_t best = 0;
+  Trust trust = Trust::kLost;
+  std::optional<std::size_t> rival;  ///< with kAmbiguous: the other alignment
+};
+
+/// Keeps the acceptable candidate with the smallest mean |r| (the first one
+/// when none is acceptable) and judges it. Candidates must not be empty.
+Choice choose_registration(std::span<const RegistrationResult> candidates, const TrustRule& rule);
+
+}  // namespace mlidar::slam

@@ -1,0 +1,239 @@
+// Issue 15, inputs: input that cannot be used is exit 3 naming the file and
+// the field (and writes nothing); unusable scans are reported per LiDAR and
+// frame; a base LiDAR without most of its frames fails the job (exit 1);
+// numeric options are range-checked at parse time (exit 2); standard input
+// and process substitution work as inputs; --threads 1 runs repeat exactly.
+#include <cstring>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "apps/reliability_support.hpp"
+#include "mlidar/io/cloud_file.hpp"
+
+namespace mlidar::test {
+namespace {
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+/// Rewrites the t field of a scan: t' = scale * t + shift.
+void retime(const fs::path& scan, double scale, double shift) {
+  io::CloudFile cloud = io::read_cloud(scan);
+  io::FieldColumn& t = *cloud.table.find("t");
+  for (std::size_t i = 0; i < cloud.table.num_points; ++i) {
+    double v = t.value(i) * scale + shift;
+    std::memcpy(t.data.data() + 8 * i, &v, 8);
+  }
+  io::write_cloud(scan, cloud);
+}
+
+/// A scan of `points` points, all at the origin + 5 m, rings `ring` (an empty cloud for 0 points).
+void replace_scan(const fs::path& scan, std::size_t points, std::uint16_t ring) {
+  Scan s;
+  for (std::size_t i = 0; i < points; ++i) {
+    s.points.emplace_back(5.0F, 0.01F * static_cast<float>(i), 0.0F);
+    s.ring.push_back(ring);
+  }
+  io::CloudFile cloud;
+  cloud.table = io::from_scan(s);
+  io::write_cloud(scan, cloud);
+}
+
+struct BadInput {
+  std::string name;
+  std::function<void(const fs::path& data)> spoil;
+  std::string file;   ///< relative to the dataset: the message must name it
+  std::string field;  ///< ... and this
+};
+
+void PrintTo(const BadInput& bad, std::ostream* out) { *out << bad.name; }
+
+class CliBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInput, IsExitThreeNamingFileAndFieldAndWritesNothing) {
+  const BadInput& bad = GetParam();
+  const fs::path dir = scratch_dir();
+  const fs::path data = copy_of_small_dataset(dir / "data");
+  bad.spoil(data);
+  const auto before = folder_checksums(data);
+  const fs::path previous = dir / "previous";  // an earlier run folder, which a failed run must leave as it was
+  fs::create_directories(previous);
+  write_text(previous / "run.json", R"({"tool": "mlidar", "command": "odometry"})");
+  write_text(previous / "trajectory.tum", "0 0 0 0 0 0 0 1\n");
+  const auto previous_before = folder_checksums(previous);
+  for (const std::string command : {"odometry", "slam --calibrate fixed", "calibrate auto"}) {
+    for (const fs::path& out : {dir / "run", previous}) {
+      const CliResult r = run_cli(command + " --dataset " + quoted(data.string()) + " --out " + quoted(out.string()));
+      EXPECT_EQ(r.exit_code, 3) << command << ": " << r.output;
+      EXPECT_NE(r.output.find((data / bad.file).string()), std::string::npos) << command << ": " << r.output;
+      EXPECT_NE(r.output.find(bad.field), std::string::npos) << command << ": " << r.output;
+    }
+    EXPECT_FALSE(fs::exists(dir / "run"));
+    EXPECT_TRUE(entries_containing(dir, ".mlidar-stage-").empty());
+  }
+  EXPECT_EQ(folder_checksums(data), before);
+  EXPECT_EQ(folder_checksums(previous), previous_before);
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+void edit_yaml(const fs::path& data, const std::string& from, const std::string& to) {
+  write_text(data / "dataset.yaml", replaced(read_text(data / "dataset.yaml"), from, to));
+}
+
+void keep_stamps(const fs::path& data, std::size_t count) {
+  std::istringstream in(read_text(data / "times.txt"));
+  std::string out, line;
+  for (std::size_t i = 0; i < count && std::getline(in, line); ++i) out += line + "\n";
+  write_text(data / "times.txt", out);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Datasets, CliBadInput,
+    ::testing::Values(BadInput{"empty_times", [](const fs::path& d) { keep_stamps(d, 0); }, "times.txt", "no stamp"},
+                      BadInput{"short_times", [](const fs::path& d) { keep_stamps(d, 11); }, "times.txt", "12 clouds for 11 stamps"},
+                      BadInput{"no_base", [](const fs::path& d) { edit_yaml(d, "base: left\n", ""); }, "dataset.yaml", "base: missing"},
+                      BadInput{"unknown_base", [](const fs::path& d) { edit_yaml(d, "base: left", "base: top"); }, "dataset.yaml",
+                               "base: names no LiDAR"},
+                      BadInput{"duplicate_key", [](const fs::path& d) { edit_yaml(d, "base: left\n", "base: left\nbase: right\n"); },
+                               "dataset.yaml", "base: given twice"},
+                      BadInput{"unsorted_angles",
+                               [](const fs::path& d) { edit_yaml(d, "vertical_angles_deg: [-15, -13", "vertical_angles_deg: [-13, -15"); },
+                               "dataset.yaml", "lidars[0].vertical_angles_deg[1]"},
+                      BadInput{"max_below_min", [](const fs::path& d) { edit_yaml(d, "max_range: 100", "max_range: 0.1"); }, "dataset.yaml",
+                               "lidars[0].max_range"},
+                      BadInput{"negative_times", [](const fs::path& d) { retime(d / "scans/left/000004.pcd", 1.0, -5.0); },
+                               "scans/left/000004.pcd", "field t"},
+                      BadInput{"times_over_10s", [](const fs::path& d) { retime(d / "scans/right/000006.pcd", 100.0, 0.0); },
+                               "scans/right/000006.pcd", "field t"},
+                      BadInput{"uint8_times",
+                               [](const fs::path& d) {
+                                 io::CloudFile cloud = io::read_cloud(d / "scans/left/000003.pcd");
+                                 io::FieldColumn& t = *cloud.table.find("t");
+                                 t.type = io::ScalarType::kU8;
+                                 t.data.assign(cloud.table.num_points, std::byte{1});
+                                 io::write_cloud(d / "scans/left/000003.pcd", cloud);
+                               },
+                               "scans/left/000003.pcd", "cannot hold a per-point time"}),
+    [](const auto& info) { return info.param.name; });
+
+TEST(CliSkippedScans, AnUnusableScanIsReportedAndTheBaseLosingMostFailsTheJob) {
+  const fs::path dir = scratch_dir();
+  const fs::path data = copy_of_small_dataset(dir / "data");
+  replace_scan(data / "scans/right/000005.pcd", 0, 0);  // empty
+  replace_scan(data / "scans/left/000007.pcd", 50, 3);  // fine (50 points, ring 3)
+  CliResult r = run_cli("odometry --dataset " + quoted(data.string()) + " --out " + quoted((dir / "run").string()));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("right: 1 of 12 frames without a usable scan (frame 5: 1 empty)"), std::string::npos) << r.output;
+  const nlohmann::json metrics = nlohmann::json::parse(std::ifstream(dir / "run" / "metrics.json"));
+  ASSERT_EQ(metrics["skipped_scans"].size(), 1U) << metrics["skipped_scans"];
+  EXPECT_EQ(metrics["skipped_scans"][0]["frame"], 5);
+  EXPECT_EQ(metrics["skipped_scans"][0]["lidar"], "right");
+  EXPECT_EQ(metrics["skipped_scans"][0]["reason"], "empty");
+  // The base LiDAR with rings beyond its model in 4 of 12 frames (33 % > 20 %): exit 1, said why.
+  for (const int k : {1, 2, 3, 4}) replace_scan(data / "scans/left" / ("00000" + std::to_string(k) + ".pcd"), 100, 40);
+  for (const std::string command : {"odometry", "slam --calibrate fixed"}) {
+    r = run_cli(command + " --dataset " + quoted(data.string()) + " --out " + quoted((dir / "run").string()));
+    EXPECT_EQ(r.exit_code, 1) << command << r.output;
+    EXPECT_NE(r.output.find("the base LiDAR left has no usable scan in 4 of 12 frames"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("ring values 40-40 beyond the model's 16 rows"), std::string::npos) << r.output;
+  }
+  r = run_cli("odometry --max-base-gaps 0.5 --dataset " + quoted(data.string()) + " --out " + quoted((dir / "run").string()));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
+TEST(CliOptions, NumbersOutOfRangeAreExitTwoNamingTheOptionAndWriteNothing) {
+  const fs::path dir = scratch_dir();
+  const std::string data = quoted(small_dataset().string());
+  const std::string out = " --out " + quoted((dir / "run").string());
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"odometry --dataset " + data + " --threads 2147483647" + out, "--threads"},
+      {"slam --dataset " + data + " --threads -1" + out, "--threads"},
+      {"odometry --scans " + quoted((small_dataset() / "scans/left").string()) + " --period 1e308" + out, "--period"},
+      {"odometry --scans " + quoted((small_dataset() / "scans/left").string()) + " --period 0" + out, "--period"},
+      {"simulate drive --perturb nan,nan" + out, "--perturb"},
+      {"simulate drive --perturb 1,inf" + out, "--perturb"},
+      {"simulate drive --frames -3" + out, "--frames"},
+      {"calibrate auto --dataset " + data + " --max-base-gaps 1.5" + out, "--max-base-gaps"},
+      {"eval traj --gt a.tum --est b.tum --delta 0", "--delta"}};
+  for (const auto& [arguments, option] : cases) {
+    const CliResult r = run_cli(arguments);
+    EXPECT_EQ(r.exit_code, 2) << arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find(option), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "run"));
+}
+
+TEST(CliConfigFiles, EveryConfigErrorIsExitThreeNamingFileAndKey) {
+  const fs::path dir = scratch_dir();
+  const std::string data = quoted(small_dataset().string());
+  write_text(dir / "planes.yaml", "inlier_distance: 50\n");
+  write_text(dir / "mloam.yaml", "window:\n  size: 5\n  size: 6\n");
+  write_text(dir / "auto.yaml", "pair_stride: 5\npair_stride: 6\n");
+  const std::string corner = quoted((dir / "no.pcd").string());
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      {"calibrate planes --ref " + corner + " --target " + corner + " --config " + quoted((dir / "planes.yaml").string()) + " --out " +
+           quoted((dir / "x.yaml").string()),
+       "planes.yaml", "inlier_distance: expected 0 < metres < 10"},
+      {"slam --dataset " + data + " --config " + quoted((dir / "mloam.yaml").string()) + " --out " + quoted((dir / "r").string()),
+       "mloam.yaml", "window.size: given twice"},
+      {"calibrate auto --dataset " + data + " --config " + quoted((dir / "auto.yaml").string()) + " --out " + quoted((dir / "r").string()),
+       "auto.yaml", "pair_stride: given twice"}};
+  for (const auto& [arguments, file, key] : cases) {
+    const CliResult r = run_cli(arguments);
+    EXPECT_EQ(r.exit_code, 3) << arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find((dir / file).string() + ": " + key), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "r"));
+}
+
+TEST(CliInputs, StandardInputAndProcessSubstitutionAreReadOnce) {
+  const std::string gt = quoted((small_dataset() / "groundtruth" / "trajectory.tum").string());
+  const std::string scan = quoted((small_dataset() / "scans/left/000000.pcd").string());
+  CliResult r = run_shell("cat " + scan + " | " + mlidar_bin() + " info -");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("fields    x:float32 y:float32 z:float32 intensity:float32 ring:uint16 t:float64"), std::string::npos)
+      << r.output;
+  r = run_shell("bash -c " + quoted(mlidar_bin() + " eval traj --gt <(cat " + gt + ") --est <(cat " + gt + ")"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("12"), std::string::npos) << r.output;
+  r = run_shell("cat " + gt + " | " + mlidar_bin() + " eval traj --gt - --est " + gt);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
+/// metrics.json without the keys that hold times.
+nlohmann::json without_timing(nlohmann::json json) {
+  for (const char* key : {"stages", "total_seconds"}) json.erase(key);
+  return json;
+}
+
+TEST(CliDeterminism, RunsAreByteIdenticalExceptTimingWhateverTheThreads) {
+  // The parallel reductions sum fixed chunks (tbb::parallel_deterministic_reduce): 1 and 2 threads give the same bytes.
+  const fs::path dir = scratch_dir();
+  for (const auto& [run, threads] : {std::pair{"a", "1"}, std::pair{"b", "1"}, std::pair{"c", "2"}})
+    ASSERT_EQ(run_cli(std::string("slam --calibrate fixed --threads ") + threads + " --dataset " + quoted(small_dataset().string()) +
+                      " --out " + quoted((dir / run).string()))
+                  .exit_code,
+              0);
+  const auto metrics = [&](const char* run) { return without_timing(nlohmann::json::parse(std::ifstream(dir / run / "metrics.json"))); };
+  for (const char* other : {"b", "c"}) {
+    for (const char* file : {"trajectory.tum", "trajectory.kitti", "map.ply", "extrinsics.yaml"})
+      EXPECT_EQ(read_text(dir / "a" / file), read_text(dir / other / file)) << file << " of run " << other;
+    EXPECT_EQ(metrics("a"), metrics(other)) << other;
+  }
+}
+
+}  // namespace
+}  // namespace mlidar::test

@@ -1,0 +1,194 @@
+// The M-LOAM estimator in process, on simulated frames made in memory: its
+// per-LiDAR states and their transitions (initializing -> calibrating ->
+// trusted, a shock back to initializing), a LiDAR missing for 10 s, and the
+// planar-motion start.
+#include <algorithm>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "mlidar/core/conversions.hpp"
+#include "mlidar/pipelines/slam_estimator.hpp"
+#include "mlidar/sim/acquisition.hpp"
+#include "mlidar/sim/rig.hpp"
+#include "mlidar/sim/scenes.hpp"
+#include "mlidar/sim/trajectory.hpp"
+#include "pose_error.hpp"
+
+namespace mlidar::test {
+namespace {
+
+using pipelines::ExtrinsicSource;
+using pipelines::LidarRole;
+using pipelines::SlamEstimator;
+using pipelines::SlamFrame;
+
+/// A simulated drive of `rig` (its LiDARs in rig order, base first) through `scene`.
+struct Drive {
+  sim::SimRig rig;
+  sim::SimTrajectory trajectory;
+  std::vector<double> stamps;
+  sim::Scene scene;
+  std::uint64_t seed = 1;
+};
+
+Drive make_drive(const std::string& rig_name, const std::string& scene, const std::string& trajectory, int frames) {
+  sim::SimRig rig = sim::named_rig(rig_name);
+  const sim::SimTrajectory path = sim::SimTrajectory::named(trajectory, rig.base_height);
+  std::vector<double> stamps;
+  std::vector<Vec3> positions;
+  for (int k = 0; k <= frames; ++k) {
+    if (k < frames) stamps.push_back(path.start_time() + 0.1 * k);
+    positions.push_back(path.T_world_base(path.start_time() + 0.1 * k).translation());
+  }
+  sim::Scene world = sim::make_scene(scene, 1, positions);
+  return {std::move(rig), path, std::move(stamps), std::move(world)};
+}
+
+/// LiDAR i's scan at frame k as the frame source gives it (stamp at its earliest point, times from there).
+Scan sweep(const Drive& drive, const sim::SimLidar& lidar, std::size_t k, std::size_t i) {
+  Scan scan = sim::simulate_sweep(drive.scene, lidar, drive.trajectory, drive.stamps[k], sim::sweep_seed(drive.seed, k, i)).scan;
+  const float earliest = *std::min_element(scan.time.begin(), scan.time.end());
+  scan.stamp += earliest;
+  for (float& t : scan.time) t -= earliest;
+  return scan;
+}
+
+/// The estimator's setups: the base as given, the others with their extrinsic's rotation off by 5 deg (online
+/// uses only that rotation, as the own odometry's up).
+std::vector<slam::LidarSetup> setups(const sim::SimRig& rig) {
+  std::vector<slam::LidarSetup> out;
+  for (std::size_t i = 0; i < rig.lidars.size(); ++i) {
+    const SE3 tilt(so3_exp(Vec3(0.0, deg_to_rad(i == 0 ? 0.0 : 5.0), 0.0)), Vec3::Zero());
+    out.push_back({rig.lidars[i].name, rig.lidars[i].model, rig.lidars[i].T_base_lidar * tilt});
+  }
+  return out;
+}
+
+/// Runs the estimator over the drive; `scan_of(k, i, lidar)` may move a LiDAR or drop its scan.
+std::vector<SlamFrame> run(SlamEstimator& estimator, const Drive& drive,
+                           const std::function<std::optional<Scan>(std::size_t, std::size_t, sim::SimLidar)>& scan_of) {
+  std::vector<SlamFrame> frames;
+  for (std::size_t k = 0; k < drive.stamps.size(); ++k) {
+    std::vector<std::optional<Scan>> scans;
+    for (std::size_t i = 0; i < drive.rig.lidars.size(); ++i) scans.push_back(scan_of(k, i, drive.rig.lidars[i]));
+    frames.push_back(estimator.process(drive.stamps[k], scans));
+  }
+  return frames;
+}
+
+/// The frames where LiDAR j's role (after the frame) differs from the frame before, with the role it took.
+std::vector<std::pair<std::size_t, LidarRole>> role_changes(const std::vector<SlamFrame>& frames, std::size_t j, LidarRole initial) {
+  std::vector<std::pair<std::size_t, LidarRole>> changes;
+  LidarRole before = initial;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    if (frames[k].lidars[j].role != before) changes.emplace_back(k, frames[k].lidars[j].role);
+    before = frames[k].lidars[j].role;
+  }
+  return changes;
+}
+
+TEST(SlamEstimator, InitializesCalibratesTrustsAndAShockSendsItBack) {
+  // rhd handheld on the campus. Algorithm 1 after 10 accepted windows and a shock baseline of 10 frames keep
+  // the run short; the transitions are what is checked, not the accuracy (the CLI tests do that).
+  constexpr std::size_t kFrames = 110, kShockFrame = 85;
+  const Drive drive = make_drive("rhd", "campus", "handheld", static_cast<int>(kFrames));
+  pipelines::SlamConfig config;
+  config.convergence.accepted_needed = 10;
+  config.shock.min_history = 10;
+  SlamEstimator estimator(config, setups(drive.rig), ExtrinsicSource::online);
+  EXPECT_EQ(estimator.track(0).role(), LidarRole::trusted);
+  EXPECT_EQ(estimator.track(1).role(), LidarRole::initializing);
+  Vec6 shock;  // Table 4.6: 10 deg about each axis, 0.1 m along each
+  shock << 0.1, 0.1, 0.1, deg_to_rad(10.0), deg_to_rad(10.0), deg_to_rad(10.0);
+  const std::vector<SlamFrame> frames = run(estimator, drive, [&](std::size_t k, std::size_t i, sim::SimLidar lidar) {
+    if (i == 1 && k >= kShockFrame) lidar.T_base_lidar = lidar.T_base_lidar * SE3::exp(shock);
+    return std::optional(sweep(drive, lidar, k, i));
+  });
+  const auto changes = role_changes(frames, 1, LidarRole::initializing);
+  ASSERT_EQ(changes.size(), 3U) << "expected calibrating, trusted, initializing";
+  EXPECT_EQ(changes[0].second, LidarRole::calibrating);
+  EXPECT_EQ(changes[1].second, LidarRole::trusted);
+  EXPECT_EQ(changes[2].second, LidarRole::initializing);
+  EXPECT_LT(changes[1].first, kShockFrame);
+  EXPECT_GE(changes[2].first, kShockFrame);  // the trigger needs 5 high frames in a row
+  EXPECT_LE(changes[2].first, kShockFrame + 10);
+  // The trusted set changes exactly at the convergence and at the shock.
+  for (std::size_t k = 0; k < frames.size(); ++k) EXPECT_EQ(frames[k].trusted_changed, k == changes[1].first || k == changes[2].first) << k;
+  for (std::size_t k = 0; k < frames.size(); ++k) EXPECT_EQ(frames[k].calibrating, frames[k].lidars[1].role != LidarRole::trusted) << k;
+
+  const auto reports = estimator.lidar_reports(frames);
+  const pipelines::SlamLidarReport& right = reports[1];
+  EXPECT_EQ(right.role, LidarRole::initializing);
+  EXPECT_EQ(right.initialized_frame, changes[0].first);
+  EXPECT_EQ(right.converged_frame, changes[1].first);
+  EXPECT_EQ(right.first_converged_frame, changes[1].first);
+  EXPECT_EQ(right.restarts, 1U);
+  ASSERT_FALSE(right.shock_frames.empty());
+  EXPECT_EQ(right.shock_frames.front(), changes[2].first);
+  EXPECT_FALSE(right.covariance.has_value()) << "a shocked LiDAR's covariance no longer holds";
+  EXPECT_NE(right.translation_start, pipelines::TranslationStart::none);  // a start happened (here from t = 0: campus)
+  EXPECT_TRUE(reports[0].shock_frames.empty());
+  EXPECT_EQ(reports[0].role, LidarRole::trusted);
+}
+
+TEST(SlamEstimator, ALidarMissingForTenSecondsAddsNoMotionPairAcrossTheGap) {
+  constexpr std::size_t kFrames = 130, kGapStart = 10, kGapEnd = 110;  // 100 frames at 10 Hz
+  const Drive drive = make_drive("rhd", "campus", "handheld", static_cast<int>(kFrames));
+  SlamEstimator estimator(pipelines::SlamConfig{}, setups(drive.rig), ExtrinsicSource::online);
+  std::vector<SlamFrame> frames;
+  std::size_t pairs_before_gap = 0, pairs_after_gap = 0;
+  frames = run(estimator, drive, [&](std::size_t k, std::size_t i, const sim::SimLidar& lidar) -> std::optional<Scan> {
+    if (i == 1 && k == kGapStart) pairs_before_gap = estimator.lidar_reports(frames).at(1).initialization.pairs_seen;
+    // A pair needs kPairStride + 1 scans without a gap: none may be added before frame kGapEnd + kPairStride.
+    if (i == 1 && k == kGapEnd + pipelines::kPairStride) pairs_after_gap = estimator.lidar_reports(frames).at(1).initialization.pairs_seen;
+    if (i == 1 && k >= kGapStart && k < kGapEnd) return std::nullopt;
+    return sweep(drive, lidar, k, i);
+  });
+  ASSERT_EQ(frames.size(), kFrames);
+  EXPECT_GT(pairs_before_gap, 0U);
+  EXPECT_EQ(pairs_after_gap, pairs_before_gap) << "a motion pair spanned the gap";
+  for (std::size_t k = 0; k < kFrames; ++k) {
+    EXPECT_EQ(frames[k].lidars[1].scan_missing, k >= kGapStart && k < kGapEnd) << k;
+    EXPECT_FALSE(frames[k].lost) << "the base alone carried the odometry through frame " << k;
+  }
+  const auto reports = estimator.lidar_reports(frames);
+  EXPECT_EQ(reports[1].missing_frames, kGapEnd - kGapStart);
+  EXPECT_EQ(reports[0].missing_frames, 0U);
+  // Pairs resume once kPairStride + 1 frames follow the gap (its own odometry restarted at the first of them).
+  EXPECT_GT(reports[1].initialization.pairs_seen, pairs_after_gap);
+  // The base's poses stay on the truth while the right LiDAR is gone: within 5 cm of the simulated path's
+  // displacement between the gap's ends.
+  const SE3 truth_start = drive.trajectory.T_world_base(drive.stamps[kGapStart]);
+  const SE3 truth_end = drive.trajectory.T_world_base(drive.stamps[kGapEnd]);
+  const SE3 estimated = frames[kGapStart].T_world_base.inverse() * frames[kGapEnd].T_world_base;
+  EXPECT_LT(translation_error_m(truth_start.inverse() * truth_end, estimated), 0.05);
+}
+
+TEST(SlamEstimator, PlanarMotionStartsFromTheObservableDirectionsAndNamesTheOthers) {
+  // rv's top and front LiDARs on a vehicle: every rotation is about the vertical. The start is eq 3.8-3.12 and
+  // the ground planes; the rotation about the axis and the translation along it are named as not observable
+  // from motion.
+  constexpr std::size_t kFrames = 60;
+  Drive drive = make_drive("rv", "campus", "vehicle", static_cast<int>(kFrames));
+  drive.rig.lidars.resize(2);  // top (base) and the next one in rig order
+  SlamEstimator estimator(pipelines::SlamConfig{}, setups(drive.rig), ExtrinsicSource::online);
+  const std::vector<SlamFrame> frames = run(
+      estimator, drive, [&](std::size_t k, std::size_t i, const sim::SimLidar& lidar) { return std::optional(sweep(drive, lidar, k, i)); });
+  const auto changes = role_changes(frames, 1, LidarRole::initializing);
+  ASSERT_FALSE(changes.empty()) << "never left initializing";
+  EXPECT_EQ(changes[0].second, LidarRole::calibrating);
+  const pipelines::SlamLidarReport report = estimator.lidar_reports(frames).at(1);
+  EXPECT_TRUE(report.initialization.planar_motion);
+  EXPECT_EQ(report.axis_translation_source, pipelines::AxisTranslationSource::ground_planes);
+  ASSERT_FALSE(report.unobservable_from_motion.empty());
+  EXPECT_NE(report.unobservable_from_motion[0].find("translation along the rotation axis"), std::string::npos);
+  // The planar start is close enough for the window (its gates are 1.0 / 0.3 m).
+  EXPECT_LT(translation_error_m(drive.rig.lidars[1].T_base_lidar, report.T_base_lidar), 0.3);
+  EXPECT_LT(rotation_error_deg(drive.rig.lidars[1].T_base_lidar, report.T_base_lidar), 2.0);
+}
+
+}  // namespace
+}  // namespace mlidar::test

@@ -1,0 +1,93 @@
+// Which registration to believe (registration_trust.hpp): the absolute bounds,
+// the bound relative to the recent frames, the tightest of several candidates
+// and ambiguity between distinct alignments.
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "mlidar/slam/registration_trust.hpp"
+
+namespace mlidar::test {
+namespace {
+
+slam::RegistrationResult candidate(double mean_residual_m, double match_ratio, const SE3& T = SE3::identity()) {
+  slam::RegistrationResult r;
+  r.T_world_base = T;
+  r.queries = 1000;
+  r.plane_matches = static_cast<std::size_t>(match_ratio * 1000.0);
+  r.mean_residual_m = mean_residual_m;
+  return r;
+}
+
+SE3 moved(double x_m, double yaw_deg = 0.0) {
+  return SE3(so3_exp(Vec3(0, 0, yaw_deg * std::numbers::pi / 180.0)), Vec3(x_m, 0, 0));
+}
+
+TEST(ResidualHistory, IsTheMedianOfTheLastOnes) {
+  slam::ResidualHistory history(3);
+  EXPECT_TRUE(std::isnan(history.median_m()));
+  history.add(0.05);
+  EXPECT_DOUBLE_EQ(history.median_m(), 0.05);
+  history.add(0.01);
+  EXPECT_DOUBLE_EQ(history.median_m(), 0.03);
+  history.add(0.9);
+  history.add(0.04);  // 0.05 leaves: {0.01, 0.9, 0.04}
+  EXPECT_DOUBLE_EQ(history.median_m(), 0.04);
+  history.add(std::nan(""));
+  EXPECT_DOUBLE_EQ(history.median_m(), 0.04);
+}
+
+TEST(TrustRule, RelativeBoundHasAFloorAndNeedsAHistory) {
+  const slam::TrustConfig config;  // ratio 2, floor 0.03 m, absolute 0.2 m / 0.5
+  const slam::TrustRule none{config, std::nan("")};
+  EXPECT_TRUE(none.trusted(candidate(0.19, 0.9)));
+  EXPECT_FALSE(none.acceptable(candidate(0.21, 0.9)));
+  EXPECT_FALSE(none.acceptable(candidate(0.05, 0.4)));
+  const slam::TrustRule recent{config, 0.05};
+  EXPECT_TRUE(recent.trusted(candidate(0.099, 0.9)));
+  EXPECT_FALSE(recent.trusted(candidate(0.101, 0.9)));
+  EXPECT_TRUE(recent.acceptable(candidate(0.101, 0.9)));
+  const slam::TrustRule tight{config, 0.005};  // 2 x 5 mm is below the floor
+  EXPECT_TRUE(tight.trusted(candidate(0.029, 0.9)));
+  EXPECT_FALSE(tight.trusted(candidate(0.031, 0.9)));
+}
+
+TEST(ChooseRegistration, KeepsTheTightestAcceptableAndJudgesIt) {
+  const slam::TrustRule rule{slam::TrustConfig{}, 0.05};
+  // The tightest of all is not acceptable (too few matches): the next one wins.
+  const std::vector<slam::RegistrationResult> candidates = {candidate(0.15, 0.9, moved(1.0)), candidate(0.01, 0.3, moved(2.0)),
+                                                            candidate(0.06, 0.9, moved(3.0)), candidate(0.061, 0.9, moved(3.05))};
+  const slam::Choice choice = slam::choose_registration(candidates, rule);
+  EXPECT_EQ(choice.best, 2u);
+  EXPECT_EQ(choice.trust, slam::Trust::kTrusted);  // 3.05 m is the same alignment (5 cm apart)
+  EXPECT_FALSE(choice.rival.has_value());
+
+  const std::vector<slam::RegistrationResult> worse = {candidate(0.15, 0.9), candidate(0.12, 0.9)};
+  EXPECT_EQ(slam::choose_registration(worse, rule).trust, slam::Trust::kResidual);
+  EXPECT_EQ(slam::choose_registration(worse, rule).best, 1u);
+
+  const std::vector<slam::RegistrationResult> none = {candidate(0.3, 0.9), candidate(0.05, 0.2)};
+  EXPECT_EQ(slam::choose_registration(none, rule).trust, slam::Trust::kLost);
+  EXPECT_EQ(slam::choose_registration(none, rule).best, 0u);
+}
+
+TEST(ChooseRegistration, AnAlignmentElsewhereThatFitsAsWellMakesItAmbiguous) {
+  const slam::TrustRule rule{slam::TrustConfig{}, 0.05};
+  // 2.1 m apart, 0.051 vs 0.055 m (within 1.15 x): ambiguous.
+  const std::vector<slam::RegistrationResult> slid = {candidate(0.055, 0.9, moved(2.1)), candidate(0.051, 0.9)};
+  const slam::Choice choice = slam::choose_registration(slid, rule);
+  EXPECT_EQ(choice.best, 1u);
+  EXPECT_EQ(choice.trust, slam::Trust::kAmbiguous);
+  EXPECT_EQ(choice.rival, 0u);
+  // Turned by 5 deg in place: also elsewhere.
+  const std::vector<slam::RegistrationResult> turned = {candidate(0.051, 0.9), candidate(0.052, 0.9, moved(0.0, 5.0))};
+  EXPECT_EQ(slam::choose_registration(turned, rule).trust, slam::Trust::kAmbiguous);
+  // Clearly worse elsewhere (0.076 vs 0.051 m: BALM 110 -> 112): the best is unique.
+  const std::vector<slam::RegistrationResult> clear = {candidate(0.076, 0.9, moved(2.1)), candidate(0.051, 0.9)};
+  EXPECT_EQ(slam::choose_registration(clear, rule).trust, slam::Trust::kTrusted);
+}
+
+}  // namespace
+}  // namespace mlidar::test
