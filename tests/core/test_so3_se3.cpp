@@ -208,5 +208,21 @@ TEST(SE3, FromMatrixRejectsNonRigidMatrices) {
   }
 }
 
+// A rotation SE3 has normalised is kept bit for bit when it is given again, so
+// a pose written with every digit and read back is the same pose (normalising
+// twice moved the last bit: found by fuzz_dataset).
+TEST(SE3, NormalisingAgainKeepsTheBits) {
+  std::size_t moved_by_normalising_twice = 0;
+  for (int k = 0; k < 1000; ++k) {
+    const double a = 0.001 * k;
+    const Quat off_unit(1.0 + 1e-9 * std::sin(7.0 * a), std::sin(a), std::cos(3.0 * a), 0.5 * std::sin(5.0 * a));
+    const Quat once = SE3(off_unit, Vec3::Zero()).rotation();
+    EXPECT_NEAR(once.norm(), 1.0, 1e-15);
+    EXPECT_EQ(SE3(once, Vec3::Zero()).rotation().coeffs(), once.coeffs()) << k;
+    if (once.normalized().coeffs() != once.coeffs()) ++moved_by_normalising_twice;
+  }
+  EXPECT_GT(moved_by_normalising_twice, 0u);  // the case exists: plain normalized() is no fixpoint
+}
+
 }  // namespace
 }  // namespace mlidar

@@ -41,7 +41,7 @@ class Checker : public YamlFields {
     const auto q = numbers(node["quaternion_wxyz"], key + ".quaternion_wxyz", 4);
     Quat rotation(q[0], q[1], q[2], q[3]);
     if (std::abs(rotation.norm() - 1.0) > 1e-6) fail(key + ".quaternion_wxyz", "expected a unit quaternion (norm 1 within 1e-6)");
-    return SE3(rotation.normalized(), Vec3(t[0], t[1], t[2]));
+    return SE3(rotation, Vec3(t[0], t[1], t[2]));  // SE3 normalises
   }
 
   /// One elevation per ring in ring order: ring r is the r-th smallest (slam/range_image.hpp).

@@ -182,7 +182,7 @@ std::vector<RosTransform> decode_tf_message(std::span<const std::byte> message, 
     for (double& x : v) x = in.get<double>("transform");
     const Quat q(v[6], v[3], v[4], v[5]);
     if (!(std::abs(q.norm() - 1.0) < 1e-3)) throw InputError(source, "transform.rotation", "is not a unit quaternion");
-    t.T_parent_child = SE3(q.normalized(), Vec3(v[0], v[1], v[2]));
+    t.T_parent_child = SE3(q, Vec3(v[0], v[1], v[2]));
   }
   return transforms;
 }

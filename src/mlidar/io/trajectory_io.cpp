@@ -38,7 +38,7 @@ StampedPose parse_tum_line(const std::vector<std::string_view>& tokens, std::siz
                      "quaternion (qx qy qz qw) has norm " + exact_number(norm) +
                          "; norms within 1e-3 of 1 are normalised, this one is too far (wrong column order or corrupt?)");
   }
-  return {v[0], SE3(q.normalized(), Vec3(v[1], v[2], v[3]))};
+  return {v[0], SE3(q, Vec3(v[1], v[2], v[3]))};
 }
 
 }  // namespace
