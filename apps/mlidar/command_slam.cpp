@@ -1,4 +1,5 @@
 // `mlidar slam`: the M-LOAM back end: odometry with online extrinsic calibration of every LiDAR.
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -17,8 +18,15 @@ void print_lidar(const pipelines::SlamLidarReport& lidar) {
   if (lidar.initialized_frame) std::cout << ", initialized at frame " << *lidar.initialized_frame;
   if (lidar.initialization.planar_motion) std::cout << " (planar motion)";
   const auto& sv = lidar.initialization.singular_values;
-  if (lidar.role == pipelines::LidarRole::initializing && lidar.initialization.pairs_stored >= 10 && sv[2] < 0.1 * sv[1])
-    std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
+  if (lidar.role == pipelines::LidarRole::initializing && lidar.initialization.pairs_stored >= 10 && sv[2] < 0.1 * sv[1]) {
+    const double sigma_m = lidar.initialization.translation_std_m;
+    if (sigma_m > 0.0)  // the planar start (eq 3.10-3.12) was solved but refused
+      std::cout << " (the rotations share one axis; the start from its own translations is too uncertain, predicted 1-sigma "
+                << std::lround(sigma_m * 100.0) << " cm above initialization.translation_max_std_m: more turning, or try "
+                << "--calibrate refine)";
+    else
+      std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
+  }
   if (lidar.translation_start == pipelines::TranslationStart::zero) std::cout << " (translation not solvable from motion: started from 0)";
   if (lidar.converged_frame) std::cout << ", converged at frame " << *lidar.converged_frame;
   if (lidar.restarts > 0) std::cout << ", " << lidar.restarts << " re-calibration(s) after an extrinsic shock";
