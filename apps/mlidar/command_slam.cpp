@@ -22,8 +22,8 @@ void print_lidar(const pipelines::SlamLidarReport& lidar) {
     const double sigma_m = lidar.initialization.translation_std_m;
     if (sigma_m > 0.0)  // the planar start (eq 3.10-3.12) was solved but refused
       std::cout << " (the rotations share one axis; the start from its own translations is too uncertain, predicted 1-sigma "
-                << std::lround(sigma_m * 100.0) << " cm above initialization.translation_max_std_m: more turning, or try "
-                << "--calibrate refine)";
+                << std::lround(sigma_m * 100.0) << " cm above initialization.translation_max_std_m: more turning, or "
+                << "`mlidar calibrate auto`, which also registers against the base's map)";
     else
       std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
   }
