@@ -22,6 +22,7 @@ struct OdometryOptions {
   int threads = 0;
   double max_base_gaps = pipelines::kDefaultMaxBaseGaps;
   bool overwrite = false;
+  std::string config;
   std::string out;
 };
 
@@ -46,6 +47,7 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
   job.lidars = split_names(options.lidars);
   job.threads = options.threads;
   job.max_base_gaps = options.max_base_gaps;
+  job.config = options.config;
   job.out = run.path();
   const auto summary = pipelines::run_odometry_job(job, terminal_progress_bar());
   run.commit();
@@ -82,6 +84,9 @@ Command register_odometry(CLI::App& app, const CliContext& context) {
   sub->add_option("--lidars", options->lidars, "Comma-separated LiDAR names of the dataset (default: all)");
   sub->add_option("--threads", options->threads, "Worker threads (0: all cores)")->check(thread_count())->capture_default_str();
   add_max_base_gaps_option(*sub, options->max_base_gaps);
+  sub->add_option("--config", options->config,
+                  "Registration parameters: the `odometry` and `selection` sections of the YAML that `slam --config` reads "
+                  "(config/mloam.yaml documents every key)");
   sub->add_option(
          "--out", options->out,
          "Run folder: trajectory.tum, trajectory.kitti, map.ply, metrics.json, run.json (a new or empty folder, or an earlier run)")

@@ -2,6 +2,7 @@
 // single LiDAR's folder of PCDs) the run folder holds a trajectory that matches
 // the simulator's ground truth, a readable map and metrics; bad input exits 3
 // and leaves no run folder behind.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -88,6 +89,54 @@ TEST(CliOdometry, ScanFolderOfOneLidarTracksThatLidar) {
   ASSERT_NE(truth.find("top"), nullptr);
   for (auto& stamped : gt.poses) stamped.T_world_base = stamped.T_world_base * truth.find("top")->T_base_lidar;
   EXPECT_LT(ate_rmse(gt, est), kMaxScanFolderAteM);
+}
+
+// `--config` takes the slam config's `selection` section (thesis Ch. 5): the
+// run still tracks the drive, and metrics.json says per frame and per LiDAR
+// how many features were chosen; `slam --config` reports the same. A bad key
+// is exit 3 naming it, with no run folder left.
+TEST(CliOdometry, ConfigSelectsGoodFeaturesAndMetricsSayHowMany) {
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate_drive(dir);
+  std::ofstream(dir / "greedy.yaml") << "selection:\n  method: greedy\n  ratio: 0.25\n";
+  const fs::path run = dir / "run";
+  auto result = run_cli("odometry --dataset " + quoted(sim.string()) + " --config " + quoted((dir / "greedy.yaml").string()) + " --out " +
+                        quoted(run.string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const Trajectory est = read_run_folder(run);
+  EXPECT_LT(ate_rmse(io::read_tum(sim / "groundtruth" / "trajectory.tum"), est), kMaxAteM);
+  const auto metrics = nlohmann::json::parse(std::ifstream(run / "metrics.json"));
+  EXPECT_TRUE(metrics["per_frame"][0]["selection"].is_null());  // the first frame only builds the map
+  for (std::size_t k = 1; k < static_cast<std::size_t>(kFrames); ++k) {
+    const auto& selection = metrics["per_frame"][k]["selection"];
+    ASSERT_TRUE(selection.is_object()) << k;
+    EXPECT_EQ(selection["method"], "greedy");
+    const auto features = selection["features"].get<std::size_t>();
+    EXPECT_EQ(features, metrics["per_frame"][k]["edges"].get<std::size_t>() + metrics["per_frame"][k]["planes"].get<std::size_t>());
+    const double share = selection["degenerate_scene"].get<bool>() ? 0.8 : 0.25;  // sec 5.4.4, adaptive by default
+    if (!selection["fell_back"].get<bool>()) {
+      EXPECT_EQ(selection["selected"].get<std::size_t>(), static_cast<std::size_t>(std::ceil(share * static_cast<double>(features))));
+    }
+    ASSERT_EQ(selection["per_lidar"].size(), 4u);
+    for (const char* lidar : {"top", "front", "left", "right"}) EXPECT_GT(selection["per_lidar"][lidar]["selected"].get<int>(), 0) << lidar;
+    EXPECT_TRUE(selection["log_det_selected"].is_number());
+  }
+  const fs::path slam_run = dir / "slam";
+  result = run_cli("slam --dataset " + quoted(sim.string()) + " --calibrate fixed --config " + quoted((dir / "greedy.yaml").string()) +
+                   " --out " + quoted(slam_run.string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto slam_metrics = nlohmann::json::parse(std::ifstream(slam_run / "metrics.json"));
+  EXPECT_EQ(slam_metrics["per_frame"][2]["selection"]["method"], "greedy");
+  EXPECT_EQ(slam_metrics["per_frame"][2]["selection"]["per_lidar"].size(), 4u);
+
+  std::ofstream(dir / "bad.yaml") << "selection:\n  method: best\n";
+  const fs::path bad_run = dir / "bad";
+  result = run_cli("odometry --dataset " + quoted(sim.string()) + " --config " + quoted((dir / "bad.yaml").string()) + " --out " +
+                   quoted(bad_run.string()));
+  EXPECT_EQ(result.exit_code, 3) << result.output;
+  EXPECT_NE(result.output.find("selection.method"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("bad.yaml"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(bad_run));
 }
 
 TEST(CliOdometry, BadInputExitsThreeAndWritesNothing) {

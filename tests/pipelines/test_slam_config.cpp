@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 36u);
+  EXPECT_EQ(slam_config_keys().size(), 49u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -76,6 +76,10 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   c.odometry.registration.max_iterations = 12;
   c.odometry.registration.huber_delta_m = 0.05;
   c.odometry.refine_deskew = true;
+  c.odometry.registration.selection.method = slam::SelectionMethod::kRandom;
+  c.odometry.registration.selection.ratio = 0.3;
+  c.odometry.registration.selection.epsilon = 0.25;
+  c.odometry.registration.selection.seed = 77;
   const std::string text = slam_config_yaml(c);
   EXPECT_NE(text, slam_config_yaml(SlamConfig{}));
   const SlamConfig back = parse_slam_config(text, "written.yaml");
@@ -95,6 +99,10 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   EXPECT_EQ(back.odometry.registration.max_iterations, 12);
   EXPECT_EQ(back.odometry.registration.huber_delta_m, 0.05);
   EXPECT_TRUE(back.odometry.refine_deskew);
+  EXPECT_EQ(back.odometry.registration.selection.method, slam::SelectionMethod::kRandom);
+  EXPECT_EQ(back.odometry.registration.selection.ratio, 0.3);
+  EXPECT_EQ(back.odometry.registration.selection.epsilon, 0.25);
+  EXPECT_EQ(back.odometry.registration.selection.seed, 77u);
 }
 
 // A write/read round trip is symmetric: a key bound to the wrong member reads back as written. Here the
@@ -116,7 +124,11 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  relative_to_others: false\n"
       "odometry:\n"
       "  plane_voxel_m: 0.7\n  edge_voxel_m: 0.3\n  local_map_radius_m: 80\n  max_iterations: 12\n  refine_deskew: true\n"
-      "  deskew_in_registration: false\n  huber_delta_m: 0.05\n";
+      "  deskew_in_registration: false\n  huber_delta_m: 0.05\n"
+      "selection:\n"
+      "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
+      "  degeneracy_interval_s: 2\n  epsilon: 0.4\n  time_budget_ms: 3\n  seed: 12\n  min_features: 40\n"
+      "  held_out_share: 0.5\n  held_out_residual_ratio: 2\n  held_out_residual_floor_m: 0.02\n";
   for (const SlamConfigKey& key : slam_config_keys()) {  // every key, each set to a value other than its default
     const std::string section = key.name.substr(0, key.name.find('.'));
     const std::string leaf = key.name.substr(key.name.find('.') + 1);
@@ -160,6 +172,20 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(c.odometry.registration.max_iterations, 12);
   EXPECT_TRUE(c.odometry.refine_deskew);
   EXPECT_FALSE(c.odometry.deskew_in_registration);
+  const slam::SelectionConfig& sel = c.odometry.registration.selection;
+  EXPECT_EQ(sel.method, slam::SelectionMethod::kGreedy);
+  EXPECT_EQ(sel.ratio, 0.3);
+  EXPECT_FALSE(sel.adaptive);
+  EXPECT_EQ(sel.degenerate_ratio, 0.7);
+  EXPECT_EQ(sel.degeneracy_threshold, 0.25);
+  EXPECT_EQ(sel.degeneracy_interval_s, 2.0);
+  EXPECT_EQ(sel.epsilon, 0.4);
+  EXPECT_EQ(sel.time_budget_ms, 3.0);
+  EXPECT_EQ(sel.seed, 12u);
+  EXPECT_EQ(sel.min_features, 40u);
+  EXPECT_EQ(sel.held_out_share, 0.5);
+  EXPECT_EQ(sel.held_out_residual_ratio, 2.0);
+  EXPECT_EQ(sel.held_out_residual_floor_m, 0.02);
   EXPECT_EQ(c.odometry.registration.huber_delta_m, 0.05);
 }
 
@@ -196,6 +222,10 @@ TEST(SlamConfig, RejectsWithFileKeyAndRange) {
       {"shock:\n  relative_to_others: maybe\n", "shock.relative_to_others", "true or false, got 'maybe'"},
       {"shock:\n  history: 10\n", "shock.min_history", "[3, shock.history = 10]"},
       {"odometry:\n  max_iterations: 0\n", "odometry.max_iterations", "an integer in [1, 1000]"},
+      {"selection:\n  method: best\n", "selection.method", "none, random or greedy, got 'best'"},
+      {"selection:\n  method: [greedy]\n", "selection.method", "none, random or greedy"},
+      {"selection:\n  ratio: 0\n", "selection.ratio", "a number in (0, 1]"},
+      {"selection:\n  epsilon: 1\n", "selection.epsilon", "a number in (0, 1)"},
       {"window: {size: 4\n", "(document)", "not valid YAML"},
   };
   for (const Rejection& r : cases) {

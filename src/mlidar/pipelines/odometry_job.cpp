@@ -10,6 +10,7 @@
 #include "mlidar/io/frame_source.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
+#include "mlidar/pipelines/slam_config.hpp"
 #include "mlidar/slam/odometry.hpp"
 
 namespace mlidar::pipelines {
@@ -45,6 +46,7 @@ Frame odometry_frame(const io::SourceFrame& source) {
 
 OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<void(int, int)>& progress) {
   if (job.threads < 0) throw UsageError("--threads must be >= 0");
+  const slam::OdometryConfig config = job.config.empty() ? slam::OdometryConfig{} : read_slam_config(job.config).odometry;
   const io::FrameSource source = open_source(job);
   const std::vector<slam::LidarSetup> lidars = lidar_setups(source);
   std::unique_ptr<tbb::global_control> threads;
@@ -52,7 +54,7 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
   std::filesystem::create_directories(job.out);
 
-  slam::Odometry odometry({}, lidars);
+  slam::Odometry odometry(config, lidars);
   FrameGaps gaps(source);
   std::vector<slam::FrameResult> results;
   OdometryJobSummary summary;

@@ -31,6 +31,9 @@ struct OdometryJob {
   std::vector<std::string> lidars;             ///< dataset LiDARs to use; empty = all
   int threads = 0;                             ///< 0 = TBB's default
   double max_base_gaps = kDefaultMaxBaseGaps;  ///< share of frames the base LiDAR may lack a usable scan in
+  /// `--config`: the same YAML as `mlidar slam --config` (slam_config.hpp);
+  /// odometry reads its `odometry` and `selection` sections. Empty: defaults.
+  std::filesystem::path config;
   std::filesystem::path out;
 };
 

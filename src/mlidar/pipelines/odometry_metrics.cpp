@@ -15,10 +15,42 @@ nlohmann::json timing_summary(std::vector<double> values) {
   return {{"mean", sum / static_cast<double>(values.size())}, {"p50", at(0.5)}, {"p95", at(0.95)}, {"max", values.back()}};
 }
 
+nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summary, const std::vector<std::string>& lidar_names) {
+  if (!summary) return nullptr;
+  const slam::SelectionReport& s = summary->report;
+  nlohmann::json per_lidar;
+  std::size_t features = 0, selected = 0;
+  for (std::size_t i = 0; i < lidar_names.size() && i < summary->lidar_selected.size(); ++i) {
+    per_lidar[lidar_names[i]] = {{"features", summary->lidar_features[i]}, {"selected", summary->lidar_selected[i]}};
+    features += summary->lidar_features[i];
+    selected += summary->lidar_selected[i];
+  }
+  const auto& degeneracy = summary->full_set_degeneracy;
+  return {{"method", slam::selection_method_name(s.method)},
+          {"features", features},
+          {"searched", s.screened},
+          {"matched", s.screened_matches},
+          {"budget", s.budget},
+          {"selected", selected},
+          {"log_det_full", degeneracy ? nlohmann::json(degeneracy->log_det) : nlohmann::json()},
+          {"translation_observability_full", degeneracy ? nlohmann::json(degeneracy->translation_observability) : nlohmann::json()},
+          {"log_det_selected", s.log_det_selected},
+          {"degenerate_scene", summary->degenerate_scene},
+          {"stopped_by_time", s.stopped_by_time},
+          {"seconds", s.seconds},
+          {"held_out", s.held_out},
+          {"held_out_matches", s.held_out_matches},
+          {"held_out_mean_residual_m", s.held_out_mean_residual_m},
+          {"fell_back", s.fell_back},
+          {"per_lidar", per_lidar}};
+}
+
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars) {
   nlohmann::json json;
   json["frames"] = frames.size();
-  for (const auto& lidar : lidars) json["lidars"].push_back(lidar.name);
+  std::vector<std::string> names;
+  for (const auto& lidar : lidars) names.push_back(lidar.name);
+  json["lidars"] = names;
   std::vector<double> total, points_in, features_out;
   std::size_t degenerate = 0, retried = 0, lost = 0, suspect = 0;
   for (std::size_t s = 0; s < slam::kStageCount; ++s) {
@@ -53,7 +85,8 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
                          {"mean_residual_m", r.mean_residual_m},
                          {"threshold_m", f.threshold_m},
                          {"edges", f.edge_features},
-                         {"planes", f.plane_features}});
+                         {"planes", f.plane_features},
+                         {"selection", selection_json(f.selection_summary(), names)}});
   }
   json["total_seconds"] = timing_summary(total);
   json["points_in"] = timing_summary(points_in);

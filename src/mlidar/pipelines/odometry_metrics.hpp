@@ -1,6 +1,8 @@
 #pragma once
 // metrics.json and map.ply of an odometry run (see odometry_job.hpp).
 #include <filesystem>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -11,8 +13,13 @@ namespace mlidar::pipelines {
 
 /// {"frames", "lidars", "stages": {NAME: {mean, p50, p95, max} seconds per frame},
 ///  "total_seconds": {...}, "points_in", "features_out", "degenerate_frames", "retried_frames",
-///  "lost_frames", "per_frame": [{stamp, eigenvalues, translation_observability, degenerate, lost, ...}]}
+///  "lost_frames", "per_frame": [{stamp, eigenvalues, translation_observability, degenerate, lost, ..., selection}]}
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars);
+
+/// A frame's feature selection (null when off): {method, features, searched, matched, budget, selected,
+/// log_det_full and translation_observability_full (null where not evaluated), log_det_selected, degenerate_scene, stopped_by_time, seconds, per_lidar: {NAME: {features, selected}}}.
+/// (shared with slam's metrics.json; `selected` is the sum over the LiDARs: the fallback's all).
+nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summary, const std::vector<std::string>& lidar_names);
 
 /// {mean, p50, p95, max} of `values` (zeros when empty).
 nlohmann::json timing_summary(std::vector<double> values);

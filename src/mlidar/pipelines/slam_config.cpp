@@ -20,7 +20,10 @@ struct Range {
   bool contains(double v) const { return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi); }
 };
 
-using Target = std::variant<double*, int*, std::size_t*, bool*>;
+using Target = std::variant<double*, int*, std::size_t*, bool*, slam::SelectionMethod*>;
+
+constexpr slam::SelectionMethod kSelectionMethods[] = {slam::SelectionMethod::kNone, slam::SelectionMethod::kRandom,
+                                                       slam::SelectionMethod::kGreedy};
 
 struct Field {
   const char* section;
@@ -162,10 +165,36 @@ std::vector<Field> odometry_fields(SlamConfig& c) {
   };
 }
 
+std::vector<Field> selection_fields(SlamConfig& c) {
+  slam::SelectionConfig& sel = c.odometry.registration.selection;
+  return {
+      {"selection", "method", {}, "none, random or greedy (Algorithm 2): which features the scan-to-map registration uses", &sel.method},
+      {"selection", "ratio", {0.0, 1.0, true, false}, "M / N kept in a well-conditioned scene (thesis 0.2)", &sel.ratio},
+      {"selection", "adaptive", {}, "keep degenerate_ratio of the features in a degenerate scene (sec 5.4.4)", &sel.adaptive},
+      {"selection", "degenerate_ratio", {0.0, 1.0, true, false}, "M / N kept in a degenerate scene (thesis 0.8)", &sel.degenerate_ratio},
+      {"selection", "degeneracy_threshold", {0.0, 1.0}, "degenerate below this translation observability of all features' information",
+       &sel.degeneracy_threshold},
+      {"selection", "degeneracy_interval_s", kPositive, "the degeneracy (a search of every feature) is evaluated again after this long",
+       &sel.degeneracy_interval_s},
+      {"selection", "epsilon", kFraction, "decay factor: each greedy round draws N / M log(1 / epsilon) candidates", &sel.epsilon},
+      {"selection", "time_budget_ms", {0.0, 1e6}, "t_max: stop choosing after this long (0: no limit; a limit is not deterministic)",
+       &sel.time_budget_ms},
+      {"selection", "seed", {0, 9007199254740992.0}, "seed of the random draws", &sel.seed},
+      {"selection", "min_features", {0, 1e9}, "never keep fewer features than this", &sel.min_features},
+      {"selection", "held_out_share", {0.0, 10.0}, "the result is checked on this share x M of the features it did not use",
+       &sel.held_out_share},
+      {"selection", "held_out_residual_ratio", {0.0, 1e6}, "they disagree above this x the chosen features' mean |r| (plus the floor)",
+       &sel.held_out_residual_ratio},
+      {"selection", "held_out_residual_floor_m", {0.0, 100.0}, "added to that bound (m); disagreeing, every feature is registered",
+       &sel.held_out_residual_floor_m},
+  };
+}
+
 /// The schema: one row per key, bound to `c`'s members, section by section.
 std::vector<Field> fields(SlamConfig& c) {
   std::vector<Field> all;
-  for (auto* section : {&initialization_fields, &convergence_fields, &window_fields, &shock_fields, &odometry_fields}) {
+  for (auto* section : {&initialization_fields, &convergence_fields, &window_fields, &shock_fields, &odometry_fields,
+                        &selection_fields}) {
     const std::vector<Field> rows = section(c);
     all.insert(all.end(), rows.begin(), rows.end());
   }
@@ -186,6 +215,7 @@ std::string short_number(double v) {
 
 std::string range_text(const Field& f) {
   if (std::holds_alternative<bool*>(f.target)) return "true or false";
+  if (std::holds_alternative<slam::SelectionMethod*>(f.target)) return "none, random or greedy";
   const bool integer = !std::holds_alternative<double*>(f.target);
   return std::string(integer ? "an integer in " : "a number in ") + (f.range.lo_open ? "(" : "[") + short_number(f.range.lo) + ", " +
          short_number(f.range.hi) + (f.range.hi_open ? ")" : "]");
@@ -197,6 +227,8 @@ std::string value_text(const Field& f) {
         using T = std::remove_pointer_t<decltype(p)>;
         if constexpr (std::is_same_v<T, bool>)
           return *p ? "true" : "false";
+        else if constexpr (std::is_same_v<T, slam::SelectionMethod>)
+          return slam::selection_method_name(*p);
         else if constexpr (std::is_same_v<T, double>)
           return number_text(*p);
         else
@@ -215,6 +247,15 @@ void read_field(const io::YamlFields& yaml, const YAML::Node& node, const Field&
   if (bool* const* flag = std::get_if<bool*>(&f.target)) {
     if (!YAML::convert<bool>::decode(node, **flag)) wrong();
     return;
+  }
+  if (slam::SelectionMethod* const* method = std::get_if<slam::SelectionMethod*>(&f.target)) {
+    for (const slam::SelectionMethod m : kSelectionMethods) {
+      if (node.Scalar() == slam::selection_method_name(m)) {
+        **method = m;
+        return;
+      }
+    }
+    wrong();
   }
   double value = 0.0;
   if (!YAML::convert<double>::decode(node, value) || !std::isfinite(value) || !f.range.contains(value)) wrong();

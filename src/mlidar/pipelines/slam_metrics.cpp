@@ -139,7 +139,8 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
                          {"lost", f.lost},
                          {"suspect", f.suspect},
                          {"trusted_changed", f.trusted_changed},
-                         {"lidars", per_lidar}});
+                         {"lidars", per_lidar},
+                         {"selection", selection_json(f.selection, f.selection_lidars)}});
   }
   json["lost_frames"] = lost;
   json["suspect_frames"] = suspect;

@@ -12,6 +12,7 @@
 #include "mlidar/calib/extrinsic_covariance.hpp"
 #include "mlidar/calib/online_hand_eye.hpp"
 #include "mlidar/core/se3.hpp"
+#include "mlidar/slam/odometry.hpp"
 #include "mlidar/slam/odometry_window.hpp"
 
 namespace mlidar::pipelines {
@@ -63,6 +64,9 @@ struct SlamFrame {
   bool trusted_changed = false;             ///< the trusted set changes from the next frame on
   std::vector<SlamLidarFrame> lidars;
   SlamStageSeconds seconds;
+  /// The trusted odometry's feature selection (none when off), for the LiDARs it registered (selection_lidars).
+  std::optional<slam::SelectionSummary> selection;
+  std::vector<std::string> selection_lidars;
 };
 
 /// Where the calibration window's translation started at the last hand-eye start.

@@ -1,6 +1,8 @@
 #include "mlidar/slam/odometry.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -82,6 +84,20 @@ std::vector<double> mean_residual_per_lidar(const std::vector<LidarFeatures>& li
   return means;
 }
 
+/// How many of each LiDAR's features are among the chosen query positions (all edges, then all planes, LiDAR after LiDAR).
+std::vector<std::size_t> selected_per_lidar(const std::vector<LidarFeatures>& lidars, std::span<const std::uint32_t> chosen) {
+  std::vector<std::size_t> counts(lidars.size(), 0);
+  std::vector<std::size_t> edge_end, plane_end;  // cumulative ends of each LiDAR's edges, then planes
+  std::size_t end = 0;
+  for (const LidarFeatures& f : lidars) edge_end.push_back(end += f.edges.size());
+  for (const LidarFeatures& f : lidars) plane_end.push_back(end += f.planes.size());
+  for (const std::uint32_t position : chosen) {
+    const auto& ends = position < edge_end.back() ? edge_end : plane_end;
+    ++counts[static_cast<std::size_t>(std::upper_bound(ends.begin(), ends.end(), position) - ends.begin())];
+  }
+  return counts;
+}
+
 void clear_features(LidarFeatures& f) {
   f.edges.clear();
   f.planes.clear();
@@ -98,6 +114,13 @@ void deskew_again(const BodyVelocity& velocity, LidarFeatures& f) {
 
 }  // namespace
 
+std::optional<SelectionSummary> FrameResult::selection_summary() const {
+  if (!registration.selection) return std::nullopt;
+  SelectionSummary summary{*registration.selection, lidar_features, lidar_selected, full_set_degeneracy, degenerate_scene};
+  summary.report.chosen = {};
+  return summary;
+}
+
 Odometry::Odometry(OdometryConfig config, std::vector<LidarSetup> lidars)
     : config_(std::move(config)),
       lidars_(std::move(lidars)),
@@ -105,7 +128,8 @@ Odometry::Odometry(OdometryConfig config, std::vector<LidarSetup> lidars)
       features_(lidars_.size()),
       edge_map_(config_.edge_voxel_m, config_.edge_points_per_voxel),
       plane_map_(config_.plane_voxel_m, config_.plane_points_per_voxel),
-      recent_residuals_(config_.trust.residual_history) {
+      recent_residuals_(config_.trust.residual_history),
+      registration_(config_.registration) {
   if (lidars_.empty()) throw std::invalid_argument("Odometry: no LiDARs");
 }
 
@@ -160,6 +184,21 @@ void Odometry::adapt_threshold(const SE3& prediction, const SE3& estimate) {
   ++error_count_;
 }
 
+RegistrationConfig Odometry::frame_registration(const SE3& prediction, double threshold, double centroid_stamp, FrameResult& frame) {
+  RegistrationConfig config = config_.registration;
+  SelectionConfig& selection = config.selection;
+  if (selection.method == SelectionMethod::kNone || !selection.adaptive) return config;
+  if (centroid_stamp - degeneracy_stamp_ >= selection.degeneracy_interval_s) {
+    frame.full_set_degeneracy = full_set_degeneracy(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction,
+                                                    threshold, config_.registration);
+    degenerate_scene_ = degenerate_scene(*frame.full_set_degeneracy, selection);
+    degeneracy_stamp_ = centroid_stamp;
+  }
+  frame.degenerate_scene = degenerate_scene_;
+  if (degenerate_scene_) selection.ratio = selection.degenerate_ratio;
+  return config;
+}
+
 TrustRule Odometry::trust_rule() const { return {config_.trust, recent_residuals_.median_m()}; }
 
 void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
@@ -172,7 +211,7 @@ void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, Fr
   redeskew(frame_features_.edge_times, used, measured, frame_features_.edges);
   redeskew(frame_features_.plane_times, used, measured, frame_features_.planes);
   result.registration = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_,
-                                             result.registration.T_world_base, result.threshold_m, config_.registration);
+                                             result.registration.T_world_base, result.threshold_m, registration_);
 }
 
 void Odometry::apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered) {
@@ -195,28 +234,34 @@ void Odometry::add_retries(const SE3& prediction, double threshold, const Motion
     starts.push_back(centroid_poses_.back().T_world_base);
     add_turned(centroid_poses_.back().T_world_base);
   }
+  // Every feature in the retries: they are for frames whose first registration
+  // was not trusted, where a selection made at a poor start is least reliable.
+  RegistrationConfig every_feature = registration_;
+  every_feature.selection.method = SelectionMethod::kNone;
   // Independent of each other (the maps are only read), so in parallel; each lands in its own slot.
   const std::size_t first = out.size();
   out.resize(first + starts.size());
   tbb::parallel_for(std::size_t{0}, starts.size(), [&](std::size_t i) {
     // A coarse pass with the initial (wide) threshold, then a fine pass.
     const RegistrationResult coarse = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, starts[i],
-                                                           std::max(threshold, config_.initial_threshold_m), config_.registration);
+                                                           std::max(threshold, config_.initial_threshold_m), every_feature);
     out[first + i] = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base,
-                                          threshold, config_.registration, motion);
+                                          threshold, every_feature, motion);
   });
 }
 
-RegistrationResult Odometry::register_robustly(const SE3& prediction, const MotionDeskew* motion, FrameResult& frame) {
+RegistrationResult Odometry::register_robustly(const SE3& prediction, double centroid_stamp, const MotionDeskew* motion,
+                                               FrameResult& frame) {
   const double threshold = error_count_ == 0
                                ? config_.initial_threshold_m
                                : std::max(config_.min_threshold_m, 3.0 * std::sqrt(error_sq_sum_ / static_cast<double>(error_count_)));
   frame.threshold_m = threshold;
+  registration_ = frame_registration(prediction, threshold, centroid_stamp, frame);
   const TrustRule rule = trust_rule();
   frame.recent_residual_m = rule.recent_median_m;
   std::vector<RegistrationResult> candidates;
   candidates.push_back(register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold,
-                                            config_.registration, motion));
+                                            registration_, motion));
   if (rule.trusted(candidates.front())) {
     frame.trust = Trust::kTrusted;
     return std::move(candidates.front());
@@ -250,6 +295,7 @@ FrameResult Odometry::process(const Frame& frame) {
   for (std::size_t i = 0; i < lidars_.size(); ++i) {
     for (std::size_t s = 0; s < kStageCount; ++s) result.seconds[s] += per_lidar[i][s];
     result.points_in += frame.scans[i].size();
+    result.lidar_features.push_back(features_[i].edges.size() + features_[i].planes.size());
     append_features(features_[i], frame_features_);
   }
   result.edge_features = frame_features_.edges.size();
@@ -264,13 +310,14 @@ FrameResult Odometry::process(const Frame& frame) {
     if (config_.deskew_in_registration && centroid_poses_.size() >= 2 && centroid_stamp > centroid_poses_.back().stamp)
       motion = MotionDeskew{frame_features_.edge_times, frame_features_.plane_times, centroid_poses_.back().T_world_base,
                             centroid_stamp - centroid_poses_.back().stamp, velocity};
-    result.registration = register_robustly(prediction, motion ? &*motion : nullptr, result);
+    result.registration = register_robustly(prediction, centroid_stamp, motion ? &*motion : nullptr, result);
     const BodyVelocity deskewed_with = result.registration.velocity_used.value_or(velocity);
     if (result.registration.velocity_used) apply_registered_deskew(velocity, deskewed_with);
     if (config_.refine_deskew && centroid_poses_.size() >= 2 && result.trust == Trust::kTrusted)
       refine_deskew(deskewed_with, centroid_stamp, result);
     T_world_centroid = result.registration.T_world_base;
     result.lidar_mean_residual_m = mean_residual_per_lidar(features_, result.registration.residuals_m);
+    if (result.registration.selection) result.lidar_selected = selected_per_lidar(features_, result.registration.selection->chosen);
     if (result.lost())
       T_world_centroid = prediction;  // flagged, not silently trusted
     else if (result.trust == Trust::kTrusted &&

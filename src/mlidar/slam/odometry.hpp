@@ -28,6 +28,8 @@
 // The world frame is the base at the first stamp: at that point the poses and
 // map are also moved from the first time centroid to the first stamp.
 // Works with one LiDAR too (T_base_lidar = identity): each LiDAR's own motion.
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "mlidar/slam/frontend.hpp"
@@ -73,6 +75,17 @@ struct OdometryConfig {
   bool deskew_in_registration = true;
 };
 
+/// A frame's feature selection as the metrics report it (FrameResult::selection_summary).
+struct SelectionSummary {
+  SelectionReport report;                   ///< without its `chosen` positions
+  std::vector<std::size_t> lidar_features;  ///< per LiDAR (construction order)
+  std::vector<std::size_t> lidar_selected;  ///< of those, the chosen
+  std::optional<Degeneracy> full_set_degeneracy;
+  bool degenerate_scene = false;
+  /// The above with the registration's report; none when it selected no features.
+  std::optional<SelectionSummary> selection_summary() const;
+};
+
 struct FrameResult {
   double stamp = 0.0;
   SE3 T_world_base;                 ///< at `stamp`
@@ -95,6 +108,16 @@ struct FrameResult {
   /// Per LiDAR (construction order): mean |r| of its matched features at the
   /// registration's last linearisation; NaN when it matched none (and on the first frame).
   std::vector<double> lidar_mean_residual_m;
+  /// Per LiDAR (construction order): its features, and with feature selection
+  /// (RegistrationResult::selection) how many of them the registration chose.
+  std::vector<std::size_t> lidar_features;
+  std::vector<std::size_t> lidar_selected;
+  /// With adaptive feature selection: the full set's degeneracy factors where
+  /// this frame evaluated them, and whether the scene counts as degenerate (sec 5.4.4).
+  std::optional<Degeneracy> full_set_degeneracy;
+  bool degenerate_scene = false;
+  /// The above with the registration's report; none when it selected no features.
+  std::optional<SelectionSummary> selection_summary() const;
 };
 
 class Odometry {
@@ -120,10 +143,13 @@ class Odometry {
  private:
   /// Constant velocity between the last two centroid poses (zero before two).
   BodyVelocity latest_velocity() const;
-  RegistrationResult register_robustly(const SE3& prediction, const MotionDeskew* motion, FrameResult& frame);
+  RegistrationResult register_robustly(const SE3& prediction, double centroid_stamp, const MotionDeskew* motion, FrameResult& frame);
   /// After a registration with MotionDeskew: the frame's features deskewed with the velocity it ended with.
   void apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered);
   TrustRule trust_rule() const;
+  /// The registration settings of this frame: with adaptive feature selection,
+  /// lambda is evaluated again every degeneracy_interval_s and sets M (sec 5.4.4).
+  RegistrationConfig frame_registration(const SE3& prediction, double threshold, double centroid_stamp, FrameResult& frame);
   /// Registrations from the retry starts (prediction and previous pose, turned).
   void add_retries(const SE3& prediction, double threshold, const MotionDeskew* motion, std::vector<RegistrationResult>& out) const;
   void refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result);
@@ -144,6 +170,9 @@ class Odometry {
   VoxelMap plane_map_;
   std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid
   ResidualHistory recent_residuals_;  ///< mean |r| of the last registered (not lost) frames
+  RegistrationConfig registration_;  ///< this frame's (frame_registration)
+  double degeneracy_stamp_ = -std::numeric_limits<double>::infinity();  ///< when lambda was last evaluated
+  bool degenerate_scene_ = false;
   double first_stamp_ = 0.0;
   double error_sq_sum_ = 0.0;
   std::size_t error_count_ = 0;

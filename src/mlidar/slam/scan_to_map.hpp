@@ -17,6 +17,10 @@
 // the translation block of H is sum w n n^T over the residual normals; when the ratio of its smallest to largest eigenvalue (scale-free:
 // independent of the number of points) falls below degeneracy_threshold, the update along the smallest one's eigenvector is dropped (the
 // prediction is kept there) and the result says so.
+// Feature selection (feature_selection.hpp, thesis Algorithm 2), when on: the
+// first linearisation screens every feature at the start (its correspondence
+// and information Lambda_i); the chosen ones, with their cached matches, are
+// the only features of the remaining iterations.
 #include <span>
 #include <vector>
 
@@ -26,6 +30,7 @@
 
 #include "mlidar/core/se3.hpp"
 #include "mlidar/slam/deskew.hpp"
+#include "mlidar/slam/feature_selection.hpp"
 #include "mlidar/slam/voxel_map.hpp"
 
 namespace mlidar::slam {
@@ -47,6 +52,28 @@ struct RegistrationConfig {
   /// (world) since its last search; closer, the last fit (plane or line) is reused
   /// and only the residual re-evaluated. 0 searches every iteration.
   double rematch_distance_m = 0.02;
+  SelectionConfig selection;  ///< good features (thesis Ch. 5); off by default
+};
+
+/// What the feature selection screened and kept (RegistrationResult::selection).
+struct SelectionReport {
+  SelectionMethod method = SelectionMethod::kNone;
+  std::size_t screened = 0;          ///< features whose correspondence was searched at the start (drawn)
+  std::size_t screened_matches = 0;  ///< of those, the ones with a correspondence
+  std::size_t budget = 0;            ///< M
+  double log_det_selected = 0.0;     ///< log det Lambda(S)
+  bool stopped_by_time = false;
+  double seconds = 0.0;  ///< screening and choosing
+  /// The check of the result on features it did not use: a sample of the
+  /// others, searched at the final pose (their mean |r| and matched share).
+  std::size_t held_out = 0;
+  std::size_t held_out_matches = 0;
+  double held_out_mean_residual_m = 0.0;
+  /// The held-out features disagreed, so the registration ran again on every
+  /// feature (the result is that one's; `chosen` then holds every query).
+  bool fell_back = false;
+  /// The chosen features' positions among the queries (edges, then planes), ascending.
+  std::vector<std::uint32_t> chosen;
 };
 
 struct RegistrationResult {
@@ -67,9 +94,20 @@ struct RegistrationResult {
   /// linearisation; NaN where it had no correspondence within the gate.
   std::vector<float> residuals_m;
   std::optional<BodyVelocity> velocity_used;  ///< with MotionDeskew: the features' final deskew velocity
+  /// With feature selection: plane_matches and edge_matches count the chosen
+  /// features only, and residuals_m is NaN for the others.
+  std::optional<SelectionReport> selection;
 
+  /// The share of the queries matched at the end. With selection: the chosen
+  /// features' share times the share of all queries that matched at the start
+  /// (the chosen are a sample of the drawn ones), so a frame that matched poorly stays poor.
   double match_ratio() const {
-    return queries == 0 ? 0.0 : static_cast<double>(plane_matches + edge_matches) / static_cast<double>(queries);
+    if (queries == 0) return 0.0;
+    const auto matched = static_cast<double>(plane_matches + edge_matches);
+    if (!selection || selection->fell_back) return matched / static_cast<double>(queries);
+    if (selection->chosen.empty()) return 0.0;
+    return matched / static_cast<double>(selection->chosen.size()) * static_cast<double>(selection->screened_matches) /
+           static_cast<double>(selection->screened);
   }
 };
 
@@ -93,5 +131,12 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_b
                                         const VoxelMap& edge_map, const VoxelMap& plane_map, const SE3& initial,
                                         double max_correspondence_m, const RegistrationConfig& config,
                                         const MotionDeskew* motion = nullptr);
+
+/// The degeneracy factors (thesis sec 5.4.4, feature_selection.hpp) of the
+/// information of every feature that has a correspondence at `pose`; one
+/// search per feature.
+Degeneracy full_set_degeneracy(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const VoxelMap& edge_map,
+                                const VoxelMap& plane_map, const SE3& pose, double max_correspondence_m, const RegistrationConfig& config);
+
 
 }  // namespace mlidar::slam
