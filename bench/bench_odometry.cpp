@@ -110,37 +110,84 @@ void BM_DeskewAllPoints(benchmark::State& state) {
 }
 BENCHMARK(BM_DeskewAllPoints)->Unit(benchmark::kMillisecond);
 
+/// Frame 1's features of all LiDARs and the maps of frame 0's.
+struct RegistrationCase {
+  LidarFeatures features;
+  VoxelMap edge_map{1.0, 10};
+  VoxelMap plane_map{1.0, 20};
+  SE3 guess{Quat::Identity(), Vec3(0.7, 0.0, 0.0)};  // ~0.1 m off the true 0.75 m step
+};
+
+const RegistrationCase& registration_case() {
+  static const RegistrationCase built = [] {
+    const Sequence& data = sequence();
+    const OdometryConfig config;
+    std::vector<LidarFeatures> features(2);
+    for (int k = 0; k < 2; ++k) {
+      for (std::size_t i = 0; i < data.lidars.size(); ++i) {
+        FrontEndWorkspace ws;
+        LidarFeatures one;
+        StageSeconds seconds{};
+        run_front_end(data.frames[static_cast<std::size_t>(k)].scans[i], data.frames[static_cast<std::size_t>(k)].stamp, data.lidars[i], {},
+                      config.front_end, ws, one, seconds);
+        auto& all = features[static_cast<std::size_t>(k)];
+        all.edges.insert(all.edges.end(), one.edges.begin(), one.edges.end());
+        all.planes.insert(all.planes.end(), one.planes.begin(), one.planes.end());
+      }
+    }
+    RegistrationCase out{features[1], VoxelMap(config.edge_voxel_m, config.edge_points_per_voxel),
+                         VoxelMap(config.plane_voxel_m, config.plane_points_per_voxel)};
+    out.edge_map.add(features[0].edges);
+    out.plane_map.add(features[0].planes);
+    return out;
+  }();
+  return built;
+}
+
 /// Frame 1's features of all LiDARs registered to a map of frame 0's.
 void BM_RegisterScanToMap(benchmark::State& state) {
-  const Sequence& data = sequence();
+  const RegistrationCase& c = registration_case();
   const OdometryConfig config;
-  std::vector<LidarFeatures> features(2);
-  for (int k = 0; k < 2; ++k) {
-    for (std::size_t i = 0; i < data.lidars.size(); ++i) {
-      FrontEndWorkspace ws;
-      LidarFeatures one;
-      StageSeconds seconds{};
-      run_front_end(data.frames[static_cast<std::size_t>(k)].scans[i], data.frames[static_cast<std::size_t>(k)].stamp, data.lidars[i], {},
-                    config.front_end, ws, one, seconds);
-      auto& all = features[static_cast<std::size_t>(k)];
-      all.edges.insert(all.edges.end(), one.edges.begin(), one.edges.end());
-      all.planes.insert(all.planes.end(), one.planes.begin(), one.planes.end());
-    }
-  }
-  VoxelMap edge_map(config.edge_voxel_m, config.edge_points_per_voxel);
-  VoxelMap plane_map(config.plane_voxel_m, config.plane_points_per_voxel);
-  edge_map.add(features[0].edges);
-  plane_map.add(features[0].planes);
-  const SE3 guess(Quat::Identity(), Vec3(0.7, 0.0, 0.0));  // ~0.1 m off the true 0.75 m step
   RegistrationResult result;
   for (auto _ : state) {
-    result = register_scan_to_map(features[1].edges, features[1].planes, edge_map, plane_map, guess, 1.0, config.registration);
+    result = register_scan_to_map(c.features.edges, c.features.planes, c.edge_map, c.plane_map, c.guess, 1.0, config.registration);
     benchmark::DoNotOptimize(result.T_world_base);
   }
   state.counters["iterations"] = result.iterations;
-  state.counters["features"] = static_cast<double>(features[1].edges.size() + features[1].planes.size());
+  state.counters["features"] = static_cast<double>(c.features.edges.size() + c.features.planes.size());
 }
 BENCHMARK(BM_RegisterScanToMap)->Unit(benchmark::kMillisecond);
+
+/// The same registration on selected features (thesis Ch. 5): method (1 random,
+/// 2 greedy), ratio in percent, epsilon in percent; counters say how many were
+/// searched and chosen and the log det kept (Table 5.2's figure).
+void BM_RegisterSelected(benchmark::State& state) {
+  const RegistrationCase& c = registration_case();
+  RegistrationConfig config = OdometryConfig{}.registration;
+  config.selection.method = state.range(0) == 1 ? SelectionMethod::kRandom : SelectionMethod::kGreedy;
+  config.selection.ratio = static_cast<double>(state.range(1)) / 100.0;
+  config.selection.epsilon = static_cast<double>(state.range(2)) / 100.0;
+  config.selection.adaptive = false;
+  RegistrationResult result;
+  for (auto _ : state) {
+    result = register_scan_to_map(c.features.edges, c.features.planes, c.edge_map, c.plane_map, c.guess, 1.0, config);
+    benchmark::DoNotOptimize(result.T_world_base);
+  }
+  const SelectionReport& report = *result.selection;
+  state.counters["searched"] = static_cast<double>(report.screened);
+  state.counters["chosen"] = static_cast<double>(report.chosen.size());
+  state.counters["log_det"] = report.log_det_selected;
+  state.counters["fell_back"] = report.fell_back ? 1.0 : 0.0;
+  state.counters["selection_ms"] = report.seconds * 1e3;
+}
+BENCHMARK(BM_RegisterSelected)
+    ->Args({1, 20, 80})
+    ->Args({2, 20, 80})
+    ->Args({2, 20, 50})
+    ->Args({2, 20, 10})
+    ->Args({2, 10, 80})
+    ->Args({2, 50, 80})
+    ->Unit(benchmark::kMillisecond);
 
 /// kFrames whole frames (front ends, registration, map update) with the first N LiDARs per iteration.
 void BM_OdometryFrame(benchmark::State& state) {

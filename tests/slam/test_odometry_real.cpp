@@ -185,5 +185,27 @@ TEST(OdometryReal, BalmKeyframesOneSecondApartAreRightOrFlagged) {
   EXPECT_LT(ate_m(run), 0.05);
 }
 
+// Greedy selection (thesis Ch. 5) with epsilon 0.1 on real keyframes 0.5 s
+// apart: the set chosen at the constant-velocity start of keyframe 26 settled
+// 13 deg off with a tight fit of its own, unflagged (measured 2026-12-02). The
+// features it did not use are checked at the final pose; they disagree there,
+// and the registration on every feature decides.
+TEST(OdometryReal, BalmGreedySelectionIsCheckedOnTheFeaturesItLeftOut) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  slam::OdometryConfig greedy;
+  greedy.registration.selection.method = slam::SelectionMethod::kGreedy;
+  greedy.registration.selection.epsilon = 0.1;
+  const BalmRun run = run_balm(20, 1, 8, greedy);
+  print("balm frames 20..27, greedy selection", run);
+  EXPECT_EQ(run.unflagged_beyond(0.1, 1.0), 0);
+  EXPECT_EQ(run.lost, 0);
+
+  slam::OdometryConfig unchecked = greedy;
+  unchecked.registration.selection.held_out_share = 0.0;
+  const BalmRun hazard = run_balm(20, 1, 8, unchecked);
+  print("balm frames 20..27, greedy selection unchecked", hazard);
+  EXPECT_GT(hazard.unflagged_beyond(0.1, 1.0), 0);
+}
+
 }  // namespace
 }  // namespace mlidar::test
