@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -30,8 +31,8 @@ struct RefineOptions {
   std::string init;
   std::string out;
   std::string report;
-  std::string ref_name = "ref";
-  std::string target_name = "target";
+  std::string ref_name;     ///< empty: the --init YAML's base, else "ref"
+  std::string target_name;  ///< empty: the --init YAML's one LiDAR besides the reference, else "target"
   int target_id = 1;
   std::string search = "auto";
 };
@@ -41,26 +42,56 @@ bool is_yaml(const std::string& path) {
   return ext == ".yaml" || ext == ".yml";
 }
 
+/// The guess T_ref_target and the names the output gives the pair.
+struct InitialGuess {
+  SE3 T_ref_target;
+  std::string ref_name;
+  std::string target_name;
+};
+
+/// The target in an extrinsics YAML: --target-name, else the one LiDAR besides
+/// the reference (or one named "target", the old default), else an error listing them.
+std::string target_in(const io::Extrinsics& extrinsics, const RefineOptions& options, const std::string& ref_name) {
+  if (!options.target_name.empty()) return options.target_name;
+  std::vector<std::string> others;
+  std::string names;
+  for (const io::LidarExtrinsic& lidar : extrinsics.lidars) {
+    if (lidar.name == ref_name) continue;
+    others.push_back(lidar.name);
+    names += (names.empty() ? "" : ", ") + lidar.name;
+  }
+  if (others.size() == 1) return others.front();
+  if (extrinsics.find("target") != nullptr) return "target";
+  throw InputError(options.init, "lidars",
+                   others.empty() ? "no LiDAR besides the reference '" + ref_name + "'; the file must hold the target's guess"
+                                  : "several LiDARs besides the reference '" + ref_name + "' (" + names +
+                                        "); name the target with --target-name");
+}
+
 /// T_ref_target from the guess file: an extrinsics YAML naming the target (and
 /// the reference, or using it as base), or OpenCalib's initial_extrinsic.txt.
-SE3 read_initial_guess(const RefineOptions& options) {
+/// Names not given default to the YAML's base and its one other LiDAR.
+InitialGuess read_initial_guess(const RefineOptions& options) {
   if (!is_yaml(options.init)) {
     const io::Extrinsics guesses = io::read_opencalib_initial_extrinsics(options.init);
     const std::string device = "device_" + std::to_string(options.target_id);
     const io::LidarExtrinsic* target = guesses.find(device);
     if (target == nullptr)
       throw InputError(options.init, "device_id", "no device " + std::to_string(options.target_id) + " (pick it with --target-id)");
-    return target->T_base_lidar;
+    return {target->T_base_lidar, options.ref_name.empty() ? "ref" : options.ref_name,
+            options.target_name.empty() ? "target" : options.target_name};
   }
   const io::Extrinsics extrinsics = io::read_extrinsics(options.init);
-  const io::LidarExtrinsic* target = extrinsics.find(options.target_name);
+  const std::string ref_name = !options.ref_name.empty() ? options.ref_name : !extrinsics.base.empty() ? extrinsics.base : "ref";
+  const std::string target_name = target_in(extrinsics, options, ref_name);
+  if (ref_name == target_name) throw UsageError("--ref-name and --target-name must differ");
+  const io::LidarExtrinsic* target = extrinsics.find(target_name);
   if (target == nullptr)
-    throw InputError(options.init, "lidars." + options.target_name, "missing; name the target LiDAR with --target-name");
-  const io::LidarExtrinsic* ref = extrinsics.find(options.ref_name);
-  if (ref == nullptr && extrinsics.base != options.ref_name)
-    throw InputError(options.init, "lidars." + options.ref_name,
-                     "missing; the file must name the reference LiDAR (--ref-name) or use it as base");
-  return ref == nullptr ? target->T_base_lidar : ref->T_base_lidar.inverse() * target->T_base_lidar;
+    throw InputError(options.init, "lidars." + target_name, "missing; name the target LiDAR with --target-name");
+  const io::LidarExtrinsic* ref = extrinsics.find(ref_name);
+  if (ref == nullptr && extrinsics.base != ref_name)
+    throw InputError(options.init, "lidars." + ref_name, "missing; the file must name the reference LiDAR (--ref-name) or use it as base");
+  return {ref == nullptr ? target->T_base_lidar : ref->T_base_lidar.inverse() * target->T_base_lidar, ref_name, target_name};
 }
 
 calib::PairSearchMode search_mode(const std::string& text) {
@@ -133,10 +164,12 @@ void print_table(const calib::PairRefineResult& r, double seconds) {
 }
 
 int run_refine(const RefineOptions& options) {
-  if (options.ref_name == options.target_name) throw UsageError("--ref-name and --target-name must differ");
+  if (!options.ref_name.empty() && options.ref_name == options.target_name)
+    throw UsageError("--ref-name and --target-name must differ");
   io::check_output_file(options.out, "--out");
   if (!options.report.empty()) io::check_output_file(options.report, "--report");
-  const SE3 T_init = read_initial_guess(options);
+  const InitialGuess guess = read_initial_guess(options);
+  const SE3& T_init = guess.T_ref_target;
   const Scan ref = io::to_scan(io::read_cloud(options.ref).table, options.ref);
   const Scan target = io::to_scan(io::read_cloud(options.target).table, options.target);
   calib::PairRefineConfig config;
@@ -149,8 +182,8 @@ int run_refine(const RefineOptions& options) {
   const bool trusted = result.verdict != calib::PairVerdict::kNotConverged;
   if (trusted) {
     io::Extrinsics extrinsics;
-    extrinsics.base = options.ref_name;
-    extrinsics.lidars = {{options.ref_name, SE3(), std::nullopt}, {options.target_name, result.T_ref_target, result.covariance}};
+    extrinsics.base = guess.ref_name;
+    extrinsics.lidars = {{guess.ref_name, SE3(), std::nullopt}, {guess.target_name, result.T_ref_target, result.covariance}};
     io::write_extrinsics(options.out, extrinsics);
   }
   if (!options.report.empty()) {
@@ -176,17 +209,20 @@ Command add_calibrate_refine(CLI::App& calibrate) {
   cmd->add_option("--ref", options->ref, "Reference LiDAR scan (PCD, PLY, KITTI .bin)")->required();
   cmd->add_option("--target", options->target, "Target LiDAR scan")->required();
   cmd->add_option("--init", options->init,
-                  "Initial guess of T_ref_target: an extrinsics YAML (.yaml/.yml) naming the target (--target-name) "
-                  "and the reference or using it as base; or OpenCalib initial_extrinsic.txt (device 0 = reference, "
-                  "the target is --target-id)")
+                  "Initial guess of T_ref_target: an extrinsics YAML (.yaml/.yml) whose base is the reference and which "
+                  "holds the target (the one other LiDAR, or --target-name); or OpenCalib initial_extrinsic.txt "
+                  "(device 0 = reference, the target is --target-id)")
       ->required();
   cmd->add_option("--out", options->out,
                   "Output extrinsics YAML (reference identity, target with covariance); "
                   "written only when the refinement converged")
       ->required();
   cmd->add_option("--report", options->report, "JSON report: verdict, reasons, starts tried, overlap, covariance");
-  cmd->add_option("--ref-name", options->ref_name, "Reference LiDAR name in --init YAML and --out")->capture_default_str();
-  cmd->add_option("--target-name", options->target_name, "Target LiDAR name in --init YAML and --out")->capture_default_str();
+  cmd->add_option("--ref-name", options->ref_name,
+                  "Reference LiDAR name in --init YAML and --out (default: the YAML's base; 'ref' with initial_extrinsic.txt)");
+  cmd->add_option("--target-name", options->target_name,
+                  "Target LiDAR name in --init YAML and --out (default: the YAML's one LiDAR besides the reference; 'target' "
+                  "with initial_extrinsic.txt)");
   cmd->add_option("--target-id", options->target_id,
                   "OpenCalib device_id of the target in initial_extrinsic.txt (lidar_cloud_path.txt maps ids to clouds)")
       ->capture_default_str()

@@ -67,6 +67,47 @@ TEST(CliCalibrateRefine, BadInitIsBadInputNamingFileAndField) {
   EXPECT_NE(result.output.find("lidars.right"), std::string::npos) << result.output;
 }
 
+// A newcomer's guess file names its LiDARs as they are called on the robot: the
+// reference is its base and the target its one other LiDAR, without --ref-name
+// / --target-name; the output uses the same names. With several other LiDARs
+// the message lists them and asks for --target-name.
+TEST(CliCalibrateRefine, NamesComeFromTheGuessFileWhenNotGiven) {
+  MLIDAR_REQUIRE_SHARED_DATA();
+  const fs::path dir = scratch_dir();
+  const std::string clouds = "calibrate refine --ref " + quoted((scene() / "top.pcd").string()) + " --target " +
+                             quoted((scene() / "right.pcd").string());
+  // The guess of scene 0001's initial_extrinsic.txt for device 2, as an extrinsics YAML (rounded).
+  const fs::path reference = dir / "reference.yaml";
+  ASSERT_EQ(run_cli(pair_arguments() + " --init " + quoted((scene() / "initial_extrinsic.txt").string()) + " --out " +
+                    quoted(reference.string()))
+                .exit_code,
+            0);
+  const io::Extrinsics refined = io::read_extrinsics(reference);
+  const SE3 T_top_right = refined.find("right")->T_base_lidar;
+  io::Extrinsics guess;
+  guess.base = "roof";
+  guess.lidars = {{"roof", SE3(), std::nullopt}, {"bumper_right", SE3(T_top_right.rotation(), T_top_right.translation() + Vec3(0.03, -0.02, 0.0)), std::nullopt}};
+  const fs::path init = dir / "guess.yaml";
+  io::write_extrinsics(init, guess);
+  const fs::path out = dir / "out.yaml";
+  CliResult result = run_cli(clouds + " --init " + quoted(init.string()) + " --out " + quoted(out.string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const io::Extrinsics written = io::read_extrinsics(out);
+  EXPECT_EQ(written.base, "roof");
+  ASSERT_NE(written.find("bumper_right"), nullptr);
+  EXPECT_LT((written.find("bumper_right")->T_base_lidar.translation() - T_top_right.translation()).norm(), 0.01);
+
+  guess.lidars.push_back({"bumper_left", SE3(), std::nullopt});
+  io::write_extrinsics(init, guess);
+  result = run_cli(clouds + " --init " + quoted(init.string()) + " --out " + quoted((dir / "o2.yaml").string()));
+  EXPECT_EQ(result.exit_code, 3) << result.output;
+  EXPECT_NE(result.output.find("bumper_right, bumper_left"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("--target-name"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(dir / "o2.yaml"));
+  result = run_cli(clouds + " --init " + quoted(init.string()) + " --target-name bumper_right --out " + quoted((dir / "o3.yaml").string()));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+}
+
 TEST(CliCalibrateRefine, MissingOptionIsUsage) {
   const CliResult result = run_cli("calibrate refine --ref a.pcd --target b.pcd --init i.txt");
   EXPECT_EQ(result.exit_code, 2) << result.output;
