@@ -41,6 +41,9 @@ Command register_bag(CLI::App& app, const CliContext& context);
 /// All sub-commands, in the order `mlidar --help` lists them. `context` must outlive the returned commands.
 std::vector<Command> register_commands(CLI::App& app, const CliContext& context);
 
+/// Ends each sub-command's --help with one or two real examples (command_examples.cpp); after register_commands.
+void add_examples(CLI::App& app);
+
 /// Worker threads a command accepts: 0 (all cores) to 4 x the cores.
 CLI::Validator thread_count();
 /// A share in [0, 1] (--max-base-gaps).

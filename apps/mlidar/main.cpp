@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("mlidar ") + mlidar::kVersion);
   const mlidar::cli::CliContext context{std::vector<std::string>(argv, argv + argc)};
   const auto commands = mlidar::cli::register_commands(app, context);
+  mlidar::cli::add_examples(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
