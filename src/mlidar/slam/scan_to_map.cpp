@@ -330,6 +330,15 @@ bool held_out_agrees(const NormalEquations& fit, std::size_t sample_size, const 
          report.held_out_mean_residual_m <= config.held_out_residual_ratio * result.mean_residual_m + config.held_out_residual_floor_m;
 }
 
+/// The registration on every feature after a selection's fell back: the selection's report, every query chosen.
+RegistrationResult with_fallback_report(RegistrationResult every_feature, SelectionReport report) {
+  report.fell_back = true;
+  report.chosen.resize(every_feature.queries);
+  std::iota(report.chosen.begin(), report.chosen.end(), 0U);
+  every_feature.selection = std::move(report);
+  return every_feature;
+}
+
 /// Residuals of a subset back at their queries' positions (NaN elsewhere).
 std::vector<float> residuals_at_queries(std::span<const float> subset, std::span<const std::uint32_t> positions, std::size_t queries) {
   std::vector<float> out(queries, std::numeric_limits<float>::quiet_NaN());
@@ -406,13 +415,9 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_i
       // The chosen features settled where the others do not fit: the full set decides.
       RegistrationConfig every_feature = config;
       every_feature.selection.method = SelectionMethod::kNone;
-      SelectionReport report = std::move(*result.selection);
-      result = register_scan_to_map(edges_in, planes_in, edge_map, plane_map, initial, max_correspondence_m, every_feature, motion);
-      report.fell_back = true;
-      report.chosen.resize(result.queries);
-      std::iota(report.chosen.begin(), report.chosen.end(), 0U);
-      result.selection = std::move(report);
-      return result;
+      return with_fallback_report(
+          register_scan_to_map(edges_in, planes_in, edge_map, plane_map, initial, max_correspondence_m, every_feature, motion),
+          std::move(*result.selection));
     }
   }
   if (!solved) return result;
