@@ -35,6 +35,13 @@ void add_information(const FeatureInformation& feature, Mat6& information) {
 
 double log_det_of(const Eigen::LLT<Mat6>& factor) { return 2.0 * factor.matrixLLT().diagonal().array().log().sum(); }
 
+/// delta I plus the features' information.
+Mat6 total_information(std::span<const FeatureInformation> features) {
+  Mat6 total = kPriorInformation * Mat6::Identity();
+  for (const FeatureInformation& f : features) add_information(f, total);
+  return total;
+}
+
 /// Every feature that has a correspondence (a budget of at least all of them).
 SelectionResult every_matched(std::size_t count, const InformationSource& information) {
   SelectionResult result;
@@ -72,14 +79,11 @@ Mat6 FeatureInformation::information() const {
 }
 
 double log_det_information(std::span<const FeatureInformation> features) {
-  Mat6 information = kPriorInformation * Mat6::Identity();
-  for (const FeatureInformation& f : features) add_information(f, information);
-  return log_det_of(Eigen::LLT<Mat6>(information));
+  return log_det_of(Eigen::LLT<Mat6>(total_information(features)));
 }
 
 Degeneracy degeneracy_of(std::span<const FeatureInformation> features) {
-  Mat6 total = kPriorInformation * Mat6::Identity();
-  for (const FeatureInformation& f : features) add_information(f, total);
+  const Mat6 total = total_information(features);
   const Vec3 spread = Eigen::SelfAdjointEigenSolver<Mat3>(total.topLeftCorner<3, 3>()).eigenvalues();
   return {log_det_of(Eigen::LLT<Mat6>(total)), spread(2) > 0.0 ? spread(0) / spread(2) : 0.0};
 }
@@ -126,7 +130,7 @@ SelectionResult select_greedy(std::size_t count, std::size_t budget, const Infor
         ++result.visited;
       }
       const FeatureInformation* f = information(candidate);  // lines 5-8: searched on first use
-      if (f == nullptr) {  // line 10: no correspondence, out of F
+      if (f == nullptr) {                                    // line 10: no correspondence, out of F
         remaining[drawn] = remaining.back();
         remaining.pop_back();
         continue;

@@ -3,10 +3,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
-#include <random>
 #include <limits>
+#include <numeric>
 #include <optional>
+#include <random>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -166,6 +166,12 @@ void keep_initial_along_weak_translation(const SE3& initial, double threshold, R
   result.T_world_base = SE3::exp(correction) * initial;
 }
 
+/// The squared radius map neighbours are searched within: the correspondence bound, at least the map's density.
+float neighborhood_sq(double max_correspondence_m, const RegistrationConfig& config) {
+  const double radius = std::max(max_correspondence_m, config.neighborhood_radius_m);
+  return static_cast<float>(radius * radius);
+}
+
 /// The features a registration iterates over: the input as given (spans),
 /// copies when they are deskewed again (MotionDeskew), or the chosen subset.
 struct WorkingSet {
@@ -222,12 +228,12 @@ WorkingSet chosen_subset(const WorkingSet& all, std::span<const std::uint32_t> c
   return set;
 }
 
-/// Each feature's information at the start pose, its correspondence searched
-/// on first use (Algorithm 2, lines 4-10); the search fills the match cache,
-/// so the first iteration does not search the chosen features again.
 /// What the start-pose search found for a feature.
 enum class StartMatch : std::uint8_t { kUnsearched, kMatched, kUnmatched };
 
+/// Each feature's information at the start pose, its correspondence searched
+/// on first use (Algorithm 2, lines 4-10); the search fills the match cache,
+/// so the first iteration does not search the chosen features again.
 class LazyInformation {
  public:
   LazyInformation(const Matcher& matcher, const WorkingSet& set)
@@ -323,8 +329,8 @@ bool held_out_agrees(const NormalEquations& fit, std::size_t sample_size, const 
   report.held_out = sample_size;
   report.held_out_matches = fit.planes + fit.edges;
   if (sample_size == 0) return true;
-  report.held_out_mean_residual_m =
-      report.held_out_matches == 0 ? std::numeric_limits<double>::infinity() : fit.residual_sum / static_cast<double>(report.held_out_matches);
+  report.held_out_mean_residual_m = report.held_out_matches == 0 ? std::numeric_limits<double>::infinity()
+                                                                 : fit.residual_sum / static_cast<double>(report.held_out_matches);
   // A wrong alignment leaves most of them unmatched, or matched loosely.
   return 2 * report.held_out_matches >= sample_size &&
          report.held_out_mean_residual_m <= config.held_out_residual_ratio * result.mean_residual_m + config.held_out_residual_floor_m;
@@ -358,12 +364,11 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_i
   result.T_world_base = initial;
   result.queries = set.size();
   result.residuals_m.assign(result.queries, std::numeric_limits<float>::quiet_NaN());
-  const double radius = std::max(max_correspondence_m, config.neighborhood_radius_m);
-  const auto neighborhood_sq = static_cast<float>(radius * radius);
+  const float search_sq = neighborhood_sq(max_correspondence_m, config);
   const double rematch_sq = config.rematch_distance_m * config.rematch_distance_m;
   const auto matcher_with = [&](MatchCache& cache, std::span<float> residuals) {
-    return Matcher{edge_map, plane_map, result.T_world_base, config, neighborhood_sq, max_correspondence_m, config.huber_delta_m,
-                   rematch_sq, cache, residuals, {}};
+    return Matcher{edge_map,   plane_map, result.T_world_base, config, search_sq, max_correspondence_m, config.huber_delta_m,
+                   rematch_sq, cache,     residuals,           {}};
   };
   const auto matcher_for = [&](std::span<float> residuals) { return matcher_with(set.cache, residuals); };
   // Thesis Algorithm 2 at the start pose (x_check); the iterations then see only the chosen features.
@@ -432,13 +437,12 @@ Degeneracy full_set_degeneracy(std::span<const Eigen::Vector3f> edges, std::span
   std::vector<float> residuals(set.size());
   std::vector<FeatureInformation> information(set.size());
   for (FeatureInformation& f : information) f.rank = 0;
-  const double radius = std::max(max_correspondence_m, config.neighborhood_radius_m);
-  const Matcher matcher{edge_map,     plane_map, pose,      config,   static_cast<float>(radius * radius), max_correspondence_m,
-                        config.huber_delta_m, 0.0, set.cache, residuals, information};
+  const Matcher matcher{
+      edge_map, plane_map, pose,      config,     neighborhood_sq(max_correspondence_m, config), max_correspondence_m, config.huber_delta_m,
+      0.0,      set.cache, residuals, information};
   linearise(set.edges, set.planes, matcher);
   std::erase_if(information, [](const FeatureInformation& f) { return f.rank == 0; });
   return degeneracy_of(information);
 }
-
 
 }  // namespace mlidar::slam
