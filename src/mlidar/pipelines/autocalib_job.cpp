@@ -211,20 +211,6 @@ std::optional<SE3> init_extrinsic(const io::Extrinsics& init, const std::filesys
   return ours->T_base_lidar.inverse() * target->T_base_lidar;
 }
 
-/// The refinement from the appearance search's start (autocalib_search.hpp), for LiDAR i whose refinement from
-/// `start` failed or had no start.
-void search_and_refine(const AutoCalibJob& job, const MotionStage& motion, std::size_t i, const std::optional<SE3>& start,
-                       LidarCalibration& c) {
-  c.search = search_refine_start(*motion.base_maps, motion.targets[i], start, job.start_search);
-  if (!c.search->T_base_target) return;
-  if (c.refine) {
-    c.refine_unsearched = std::move(c.refine);
-    c.unsearched_start = c.refine_start;
-  }
-  c.refine = refine_against_base(*motion.base_maps, motion.targets[i], *c.search->T_base_target, job.refine);
-  c.refine_start = RefineStart::search;
-}
-
 /// Stage 3 for every auxiliary LiDAR: from hand-eye's result when usable, else from --init.
 void refine_all(const AutoCalibJob& job, const MotionStage& motion, std::size_t base, const std::optional<io::Extrinsics>& init,
                 AutoCalibSummary& summary) {
@@ -241,10 +227,16 @@ void refine_all(const AutoCalibJob& job, const MotionStage& motion, std::size_t 
         throw InputError(job.init.string(), "lidars." + c.name, "missing; --stage refine needs every LiDAR's start");
       if (start) c.refine_start = RefineStart::init;
     }
-    if (start) c.refine = refine_against_base(*motion.base_maps, motion.targets[i], *start, job.refine);
-    // Hand-eye's translation came out 4-18 m off on bumper LiDARs (lyft on the street) while the refinement from
-    // it found no candidate: the appearance search then looks for the start itself.
-    if ((!c.refine || c.refine->verdict != RefineVerdict::ok) && job.search) search_and_refine(job, motion, i, start, c);
+    AppearanceCalibration appearance =
+        calibrate_by_appearance(*motion.base_maps, motion.targets[i], start, job.refine, job.search ? &job.start_search : nullptr);
+    c.refine = std::move(appearance.from_start);
+    c.search = std::move(appearance.search);
+    if (appearance.from_search) {
+      c.refine_unsearched = std::move(c.refine);
+      if (c.refine_unsearched) c.unsearched_start = c.refine_start;
+      c.refine = std::move(appearance.from_search);
+      c.refine_start = RefineStart::search;
+    }
     // A start the appearance cannot confirm is not a result.
     c.usable = c.refine && c.refine->verdict == RefineVerdict::ok;
     if (!c.usable) continue;

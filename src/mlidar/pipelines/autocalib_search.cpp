@@ -162,4 +162,21 @@ StartSearchResult search_refine_start(const BaseLocalMaps& base, const TargetFra
   return result;
 }
 
+const RefineResult* AppearanceCalibration::result() const {
+  if (from_search) return &*from_search;
+  return from_start ? &*from_start : nullptr;
+}
+
+AppearanceCalibration calibrate_by_appearance(const BaseLocalMaps& base, const TargetFrames& target, const std::optional<SE3>& start,
+                                              const RefineConfig& refine, const StartSearchConfig* search) {
+  AppearanceCalibration out;
+  if (start) out.from_start = refine_against_base(base, target, *start, refine);
+  // Hand-eye's translation came out 4-18 m off on bumper LiDARs (lyft on the street) while the refinement from
+  // it found no candidate: the appearance search then looks for the start itself.
+  if (out.ok() || search == nullptr) return out;
+  out.search = search_refine_start(base, target, start, *search);
+  if (out.search->T_base_target) out.from_search = refine_against_base(base, target, *out.search->T_base_target, refine);
+  return out;
+}
+
 }  // namespace mlidar::pipelines

@@ -64,4 +64,20 @@ struct StartSearchResult {
 StartSearchResult search_refine_start(const BaseLocalMaps& base, const TargetFrames& target, const std::optional<SE3>& guess,
                                       const StartSearchConfig& config);
 
+/// One target LiDAR calibrated by its appearance against the base's local maps, the same way in `calibrate auto`
+/// and in `slam --calibrate online` (issue 25): the refinement from the motion's start when there is one; when it
+/// fails, or there is none, the refinement from the appearance search's start.
+struct AppearanceCalibration {
+  std::optional<RefineResult> from_start;   ///< the refinement from `start`, when given
+  std::optional<StartSearchResult> search;  ///< run when from_start is absent or not ok (and the search is on)
+  std::optional<RefineResult> from_search;  ///< the refinement from the search's start, when it found one
+  /// The refinement that decides: from_search when it ran, else from_start; null when neither ran.
+  const RefineResult* result() const;
+  bool ok() const { return result() != nullptr && result()->verdict == RefineVerdict::ok; }
+};
+
+/// `search`: null for no search.
+AppearanceCalibration calibrate_by_appearance(const BaseLocalMaps& base, const TargetFrames& target, const std::optional<SE3>& start,
+                                              const RefineConfig& refine, const StartSearchConfig* search);
+
 }  // namespace mlidar::pipelines
