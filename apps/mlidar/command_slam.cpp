@@ -23,15 +23,23 @@ void print_lidar(const pipelines::SlamLidarReport& lidar) {
     if (sigma_m > 0.0)  // the planar start (eq 3.10-3.12) was solved but refused
       std::cout << " (the rotations share one axis; the start from its own translations is too uncertain, predicted 1-sigma "
                 << std::lround(sigma_m * 100.0) << " cm above initialization.translation_max_std_m: more turning, or "
-                << "`mlidar calibrate auto`, which also registers against the base's map)";
+                << "`mlidar calibrate auto`, which registers against the base's map over the whole drive)";
     else
       std::cout << " (the rotations share one axis: the rotation about it is unobservable by hand-eye; try --calibrate refine)";
   }
   if (lidar.translation_start == pipelines::TranslationStart::zero) std::cout << " (translation not solvable from motion: started from 0)";
+  if (lidar.translation_start == pipelines::TranslationStart::appearance)
+    std::cout << " (started from its appearance against the base's map: hand-eye had not started it)";
   if (lidar.converged_frame) std::cout << ", converged at frame " << *lidar.converged_frame;
   if (lidar.restarts > 0) std::cout << ", " << lidar.restarts << " re-calibration(s) after an extrinsic shock";
   if (lidar.missing_frames > 0) std::cout << ", " << lidar.missing_frames << " frame(s) without a scan";
   std::cout << '\n';
+  if (lidar.role == pipelines::LidarRole::initializing && !lidar.appearance_attempts.empty()) {
+    const pipelines::AppearanceAttempt& last = lidar.appearance_attempts.back();
+    std::cout << "    appearance start at frame " << last.frame << " (" << lidar.appearance_attempts.size() << " attempt(s), "
+              << last.frames_used << " frames, " << (last.searched ? "with" : "without") << " search): " << last.verdict << ", "
+              << last.message << "; tried again every initialization.appearance_after_frames frames; else `--calibrate refine` from the dataset's extrinsics, or `mlidar calibrate auto` over the whole drive\n";
+  }
   if (lidar.restarts == 0 && !lidar.reinitialization_frames.empty())
     std::cout << "    re-initialized " << lidar.reinitialization_frames.size()
               << " time(s): its window residuals stayed high against the map\n";

@@ -277,6 +277,7 @@ TEST(CliSlam, PlanarMotionStartsFromWhatIsObservableAndSaysWhich) {
   EXPECT_EQ(init["unobservable_from_motion"].size(), 2u);
   EXPECT_EQ(init["axis_translation_source"], "ground planes");
   EXPECT_EQ(init["translation_start"], "hand_eye");
+  EXPECT_TRUE(init["appearance"].empty()) << "hand-eye started it at frame 45: no appearance start";
   ASSERT_GT(metrics["per_lidar"]["right"]["accepted"].get<int>(), 0);
   EXPECT_TRUE(init["observable_in_window"].get<bool>());
   EXPECT_TRUE(metrics["per_lidar"]["right"]["reinitialization_frames"].empty());

@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 49u);
+  EXPECT_EQ(slam_config_keys().size(), 51u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -113,7 +113,8 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  max_constraints: 123\n  rotation_threshold: 0.5\n  huber_delta_rad: 0.03\n  planar_ratio: 0.07\n"
       "  translation_min_ratio: 0.002\n  translation_max_std_m: 0.4\n  translation_min_pairs: 5\n  planar_rotation: false\n"
       "  planar_min_condition: 0.004\n  planar_min_pairs: 31\n  reinitialize_after_windows: 11\n"
-      "  reinitialize_residual_ratio: 2.5\n  zero_translation_after_pairs: 21\n"
+      "  reinitialize_residual_ratio: 2.5\n  zero_translation_after_pairs: 21\n  appearance_after_frames: 40\n"
+      "  appearance_search: false\n"
       "convergence:\n"
       "  lambda_calib: 65.5\n  accepted_needed: 30\n  bias_translation_sd_m: 0.02\n  bias_rotation_sd_deg: 0.06\n"
       "  outlier_mads: 2.5\n"
@@ -150,6 +151,8 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(c.start.reinitialize_windows, 11u);
   EXPECT_EQ(c.start.reinitialize_residual_ratio, 2.5);
   EXPECT_EQ(c.start.zero_translation_after_pairs, 21u);
+  EXPECT_EQ(c.start.appearance_after_frames, 40u);
+  EXPECT_FALSE(c.appearance.search);
   EXPECT_EQ(c.convergence.lambda_calib, 65.5);
   EXPECT_EQ(c.convergence.accepted_needed, 30u);
   EXPECT_EQ(c.convergence.bias_translation_sd_m, 0.02);

@@ -12,6 +12,7 @@
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/pipelines/slam_estimator.hpp"
 #include "mlidar/sim/acquisition.hpp"
+#include "mlidar/sim/lidar_models.hpp"
 #include "mlidar/sim/rig.hpp"
 #include "mlidar/sim/scenes.hpp"
 #include "mlidar/sim/trajectory.hpp"
@@ -188,6 +189,105 @@ TEST(SlamEstimator, PlanarMotionStartsFromTheObservableDirectionsAndNamesTheOthe
   // The planar start is close enough for the window (its gates are 1.0 / 0.3 m).
   EXPECT_LT(translation_error_m(drive.rig.lidars[1].T_base_lidar, report.T_base_lidar), 0.3);
   EXPECT_LT(rotation_error_deg(drive.rig.lidars[1].T_base_lidar, report.T_base_lidar), 2.0);
+}
+
+/// A config under which the hand-eye never starts a LiDAR: its translation is never certain enough, and the
+/// window never starts from t = 0; the appearance start after `appearance_after_frames` (0: never).
+pipelines::SlamConfig hand_eye_held(std::size_t appearance_after_frames) {
+  pipelines::SlamConfig config;
+  config.initialization.translation_max_std_m = 1e-9;
+  config.start.zero_translation_after_pairs = 0;
+  config.start.appearance_after_frames = appearance_after_frames;
+  return config;
+}
+
+TEST(SlamEstimator, AppearanceStartsALidarTheHandEyeHolds) {
+  // rv's top and right LiDARs on a vehicle with the hand-eye held back (as the planar start's 0.46 m 1-sigma held
+  // rv seed 5's left LiDAR): after 30 frames the LiDAR is calibrated by its appearance against the base's maps
+  // of those frames, as `calibrate auto` does, and its window starts from there. Without the appearance start
+  // the same run never leaves initializing (the control: the held config really holds it).
+  constexpr std::size_t kFrames = 60, kAfter = 30;
+  Drive drive = make_drive("rv", "campus", "vehicle", static_cast<int>(kFrames));
+  drive.rig.lidars.resize(2);
+  const auto scans = [&](std::size_t k, std::size_t i, const sim::SimLidar& lidar) { return std::optional(sweep(drive, lidar, k, i)); };
+
+  SlamEstimator held(hand_eye_held(0), setups(drive.rig), ExtrinsicSource::online);
+  const std::vector<SlamFrame> held_frames = run(held, drive, scans);
+  EXPECT_TRUE(role_changes(held_frames, 1, LidarRole::initializing).empty()) << "the hand-eye started it: the control does not hold";
+  EXPECT_TRUE(held.lidar_reports(held_frames).at(1).appearance_attempts.empty());
+
+  SlamEstimator estimator(hand_eye_held(kAfter), setups(drive.rig), ExtrinsicSource::online);
+  const std::vector<SlamFrame> frames = run(estimator, drive, scans);
+  const auto changes = role_changes(frames, 1, LidarRole::initializing);
+  ASSERT_FALSE(changes.empty()) << "never left initializing";
+  EXPECT_EQ(changes[0], std::make_pair(kAfter, LidarRole::calibrating));
+  const pipelines::SlamLidarReport report = estimator.lidar_reports(frames).at(1);
+  EXPECT_EQ(report.translation_start, pipelines::TranslationStart::appearance);
+  ASSERT_EQ(report.appearance_attempts.size(), 1U);
+  const pipelines::AppearanceAttempt& attempt = report.appearance_attempts[0];
+  EXPECT_TRUE(attempt.ok) << attempt.verdict << ": " << attempt.message;
+  EXPECT_EQ(attempt.frame, kAfter);
+  EXPECT_EQ(attempt.frames_used, kAfter + 1);  // frames 0-30, all kept
+  ASSERT_TRUE(attempt.T_base_lidar.has_value());
+  // The start is inside the window's gates (1.0 / 0.3 m, as for the planar start), from a hand-eye estimate with
+  // no translation (the LiDAR is mounted about 1.3 m from the base), and the windows from it reach what a
+  // calibration must (0.3 deg / 3 cm).
+  const SE3& truth = drive.rig.lidars[1].T_base_lidar;
+  ASSERT_GT(truth.translation().norm(), 1.0);
+  EXPECT_LT(rotation_error_deg(truth, *attempt.T_base_lidar), 2.0);
+  EXPECT_LT(translation_error_m(truth, *attempt.T_base_lidar), 0.3);
+  std::size_t windows = 0;
+  for (std::size_t k = kAfter + 1; k < kFrames; ++k) {
+    const std::optional<SE3>& window = frames[k].lidars[1].window_estimate;
+    if (!window) continue;
+    ++windows;
+    EXPECT_LT(rotation_error_deg(truth, *window), 0.3) << k;
+    EXPECT_LT(translation_error_m(truth, *window), 0.03) << k;
+  }
+  EXPECT_GT(windows, (kFrames - kAfter) / 2);
+}
+
+TEST(AppearanceHistory, KeepsTheLastFramesAndTheOthersScansAtCandidateFramesOnly) {
+  constexpr std::size_t kCapacity = 10, kStep = 5;
+  pipelines::AppearanceHistory history(kCapacity, kStep);
+  const auto scan_at = [](double stamp) {
+    Scan scan;
+    scan.stamp = stamp;
+    scan.points = {Eigen::Vector3f(1.0F, 0.0F, 0.0F), Eigen::Vector3f(0.0F, 5.0F, 0.0F)};
+    return scan;
+  };
+  for (std::size_t k = 0; k < 12; ++k) {
+    const double stamp = 0.1 * static_cast<double>(k);
+    // No base scan (the base's maps then keep nothing): this checks which frames and scans are kept.
+    history.add(k, stamp, SE3::identity(), false, {std::nullopt, scan_at(stamp), scan_at(stamp)}, {false, true, k < 10});
+  }
+  const slam::LidarSetup base{"top", sim::lidar_model("RS-LiDAR-16"), SE3::identity()};
+  const slam::LidarSetup lidar{"right", sim::lidar_model("RS-LiDAR-16"), SE3::identity()};
+  const pipelines::RefineConfig refine;
+  // Frames 2-11 are kept; the first candidate frame from 0 on is 5: local frames 0-6 are frames 5-11.
+  const auto from_start = history.inputs(0, base, lidar, 1, refine);
+  ASSERT_TRUE(from_start.has_value());
+  EXPECT_EQ(from_start->first_frame, 5U);
+  ASSERT_EQ(from_start->base.trajectory().stamps.size(), 7U);
+  EXPECT_DOUBLE_EQ(from_start->base.trajectory().stamps[0], 0.5);
+  ASSERT_EQ(from_start->target.overlap_points.size(), 7U);
+  for (std::size_t k = 0; k < 7; ++k) EXPECT_EQ(from_start->target.overlap_points[k].has_value(), k % kStep == 0) << k;
+  const std::optional<Scan> candidate = from_start->target.read_scan(5);  // frame 10
+  ASSERT_TRUE(candidate.has_value());
+  EXPECT_DOUBLE_EQ(candidate->stamp, 1.0);
+  EXPECT_FALSE(from_start->target.read_scan(1).has_value()) << "frame 6 is no candidate frame: its scan is not kept";
+  // LiDAR 2 was kept only before frame 10.
+  const auto third = history.inputs(0, base, lidar, 2, refine);
+  ASSERT_TRUE(third.has_value());
+  EXPECT_TRUE(third->target.overlap_points[0].has_value());
+  EXPECT_FALSE(third->target.overlap_points[5].has_value());
+  // From frame 6 on the first candidate is 10 (two frames); from 11 on there is none.
+  const auto late = history.inputs(6, base, lidar, 1, refine);
+  ASSERT_TRUE(late.has_value());
+  EXPECT_EQ(late->first_frame, 10U);
+  EXPECT_FALSE(history.inputs(11, base, lidar, 1, refine).has_value());
+  history.clear();
+  EXPECT_TRUE(history.empty());
 }
 
 }  // namespace

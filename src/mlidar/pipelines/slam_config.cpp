@@ -85,6 +85,13 @@ std::vector<Field> initialization_fields(SlamConfig& c) {
        {0, 1e5},
        "pairs with the rotation ready but not the translation before the window starts from t = 0 (0: never)",
        &c.start.zero_translation_after_pairs},
+      {"initialization",
+       "appearance_after_frames",
+       {0, 1e5},
+       "frames initializing (and between attempts) before the LiDAR is calibrated by its appearance against the base's map (0: never)",
+       &c.start.appearance_after_frames},
+      {"initialization", "appearance_search", {}, "the appearance start searches a start when the refinement from hand-eye's fails",
+       &c.appearance.search},
   };
 }
 

@@ -14,6 +14,7 @@
 #include "mlidar/calib/convergence_monitor.hpp"
 #include "mlidar/calib/online_hand_eye.hpp"
 #include "mlidar/calib/shock_detector.hpp"
+#include "mlidar/pipelines/slam_appearance_start.hpp"
 #include "mlidar/slam/odometry.hpp"
 
 namespace mlidar::pipelines {
@@ -36,12 +37,18 @@ struct StartParams {
   /// Pairs added with the rotation ready but not the translation before the
   /// window starts from the rotation and t = 0 (0: never).
   std::size_t zero_translation_after_pairs = 20;
+  /// Frames after a LiDAR began initializing, and between two attempts, before it is calibrated by its appearance
+  /// against the base's local maps on the frames kept since, as `calibrate auto` does (slam_appearance_start.hpp;
+  /// 0: never). Also the frames kept: each attempt runs on the last of them.
+  std::size_t appearance_after_frames = 100;
 };
 
 struct SlamConfig {
   /// Eq 4.15-4.18; measured defaults beyond the thesis: the translation's predicted std gate and the planar start.
   calib::OnlineHandEyeConfig initialization{.translation_max_std_m = 0.1, .planar_rotation = true, .planar_min_pairs = 30};
   StartParams start;
+  /// The appearance start's refinement and search (`calibrate auto`'s defaults; its `search` is initialization.appearance_search).
+  AppearanceStartConfig appearance;
   /// Algorithm 1; the shared-error floor measured on the simulated protocol (docs/benchmarks.md "Extrinsic covariance").
   calib::ConvergenceConfig convergence{.bias_translation_sd_m = 0.01, .bias_rotation_sd_deg = 0.04, .outlier_mads = 3.0};
   WindowParams window;

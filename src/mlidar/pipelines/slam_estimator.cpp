@@ -1,5 +1,6 @@
 #include "mlidar/pipelines/slam_estimator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -24,7 +25,10 @@ Frame trusted_frame(double stamp, const std::vector<std::optional<Scan>>& scans,
 }  // namespace
 
 SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source)
-    : config_(std::move(config)), source_(source), shock_(lidars.size(), config_.shock) {
+    : config_(std::move(config)),
+      source_(source),
+      shock_(lidars.size(), config_.shock),
+      history_(config_.start.appearance_after_frames + 1, static_cast<std::size_t>(std::max(config_.appearance.refine.frame_step, 1))) {
   if (lidars.empty()) throw std::invalid_argument("SlamEstimator: no LiDARs");
   tracks_.reserve(lidars.size());  // the tracks refer to config_, never moved after this
   for (std::size_t j = 0; j < lidars.size(); ++j) tracks_.emplace_back(std::move(lidars[j]), j == 0, source, config_);
@@ -49,11 +53,24 @@ double SlamEstimator::base_residual(const std::vector<std::optional<Scan>>& scan
   return registered[0];  // the base is always trusted_[0]
 }
 
+void SlamEstimator::keep_for_appearance(std::size_t k, double stamp, const std::vector<std::optional<Scan>>& scans) {
+  std::vector<bool> initializing(tracks_.size(), false);
+  for (std::size_t j = 1; j < tracks_.size(); ++j) initializing[j] = tracks_[j].role() == LidarRole::initializing;
+  if (config_.start.appearance_after_frames == 0 || std::find(initializing.begin(), initializing.end(), true) == initializing.end()) {
+    history_.clear();  // nothing kept while every LiDAR is past its start
+    return;
+  }
+  history_.add(k, stamp, last_odometry_.T_world_base, last_odometry_.flagged(), scans, initializing);
+}
+
 void SlamEstimator::step_tracks(const TrackFrame& frame, const std::vector<std::optional<Scan>>& scans, SlamFrame& out) {
+  keep_for_appearance(frame.index, frame.stamp, scans);
   for (std::size_t j = 1; j < tracks_.size(); ++j) {
     const LidarRole before = tracks_[j].role();
     const auto start = Clock::now();
-    const TrackTransition transition = tracks_[j].step(frame, scans[j], out.lidars[j]);
+    TrackTransition transition = tracks_[j].step(frame, scans[j], out.lidars[j]);
+    if (transition == TrackTransition::none && tracks_[j].appearance_due(frame.index))
+      transition = tracks_[j].start_by_appearance(history_, tracks_[0].setup(), j, frame.index);
     if (scans[j] && before == LidarRole::initializing) out.seconds.initialization += seconds_since(start);
     if (scans[j] && before == LidarRole::calibrating && !frame.odometry->flagged()) out.seconds.calibration += seconds_since(start);
     if (transition == TrackTransition::converged) {

@@ -12,7 +12,10 @@
 //     per frame feeds calib::ShockDetector; a trigger sends that LiDAR back to
 //     initializing (online only; the base's trigger is reported, it defines
 //     the base frame);
-//   - optionally the sliding window over the trusted poses (window.refine_odometry).
+//   - optionally the sliding window over the trusted poses (window.refine_odometry);
+//   - while some LiDAR initializes, the last frames for its appearance start
+//     (slam_appearance_start.hpp): the base's scans and trusted poses, the
+//     initializing LiDARs' scans at the refinement's candidate frames.
 // A change of the trusted set takes effect at the next frame
 // (Odometry::set_lidars): the world, the pose history and the local map are
 // kept (an earlier version restarted the odometry and its map there; the
@@ -60,6 +63,7 @@ class SlamEstimator {
   std::vector<slam::LidarSetup> trusted_setups();
   /// The base's mean residual against the map at this frame (-1: none).
   double base_residual(const std::vector<std::optional<Scan>>& scans) const;
+  void keep_for_appearance(std::size_t k, double stamp, const std::vector<std::optional<Scan>>& scans);
   void step_tracks(const TrackFrame& frame, const std::vector<std::optional<Scan>>& scans, SlamFrame& out);
   void detect_shocks(SlamFrame& out);
 
@@ -71,6 +75,7 @@ class SlamEstimator {
   std::vector<std::size_t> trusted_;          ///< indices in odometry_'s LiDAR order
   slam::FrameResult last_odometry_;
   std::optional<SlamPoseWindow> pose_window_;  ///< window.refine_odometry
+  AppearanceHistory history_;                  ///< the last appearance_after_frames + 1 frames while some LiDAR initializes
   bool trusted_changed_ = false;
   std::size_t frames_ = 0;
 };

@@ -75,6 +75,8 @@ std::string_view to_string(TranslationStart start) {
       return "hand_eye";
     case TranslationStart::zero:
       return "zero";
+    case TranslationStart::appearance:
+      return "appearance";
   }
   return "";
 }
@@ -125,13 +127,17 @@ std::unique_ptr<slam::Odometry> LidarTrack::own_odometry() const {
 }
 
 LidarTrack::Initializing LidarTrack::start_initializing(bool own_odometry_now) {
-  Initializing state{nullptr, calib::OnlineHandEye(config_->initialization), {}, {}, 0, false};
+  Initializing state{nullptr, calib::OnlineHandEye(config_->initialization), {}, {}, 0, false, std::nullopt, 0};
   if (own_odometry_now) state.own = own_odometry();
   return state;
 }
 
 TrackTransition LidarTrack::step(const TrackFrame& frame, const std::optional<Scan>& scan, SlamLidarFrame& out) {
   if (auto* initializing = std::get_if<Initializing>(&state_)) {
+    if (!initializing->first_frame) {
+      initializing->first_frame = frame.index;
+      initializing->next_appearance = frame.index + config_->start.appearance_after_frames;
+    }
     if (!scan) {
       initializing->recent.clear();  // no motion pair across the gap
       initializing->after_gap = true;
@@ -187,6 +193,7 @@ SlamLidarReport LidarTrack::report(std::span<const SlamFrame> frames, std::size_
   r.translation_start = start_.translation_start;
   r.unobservable_from_motion = start_.unobservable_from_motion;
   r.axis_translation_source = start_.axis_translation_source;
+  r.appearance_attempts = start_.appearance;
   const auto converged = transitions(frames, index, initial_role_, LidarRole::calibrating, LidarRole::trusted);
   r.converged_frame = last_of(converged);
   if (!converged.empty()) r.first_converged_frame = converged.front();

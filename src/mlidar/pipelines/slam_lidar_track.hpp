@@ -4,6 +4,8 @@
 //
 //   Initializing --hand-eye ready (eq 4.15-4.18), or the rotation alone for
 //                  StartParams::zero_translation_after_pairs pairs (t = 0)--> Calibrating
+//   Initializing --StartParams::appearance_after_frames frames without that,
+//                  then an ok appearance start (slam_appearance_start.hpp)--> Calibrating
 //   Calibrating  --Algorithm 1 accepted L_calib windows (eq 4.21)---------> Trusted
 //   Calibrating  --its windows' residual stays above the base's, none
 //                  accepted (StartParams::reinitialize_*)-------------------> Initializing
@@ -33,6 +35,7 @@
 
 #include "mlidar/calib/convergence_monitor.hpp"
 #include "mlidar/calib/online_hand_eye.hpp"
+#include "mlidar/pipelines/slam_appearance_start.hpp"
 #include "mlidar/pipelines/slam_config.hpp"
 #include "mlidar/pipelines/slam_types.hpp"
 #include "mlidar/slam/calibration_window.hpp"
@@ -73,6 +76,11 @@ class LidarTrack {
 
   /// One frame with this LiDAR's scan, or none (a gap: motion pairs and windows do not span it).
   TrackTransition step(const TrackFrame& frame, const std::optional<Scan>& scan, SlamLidarFrame& out);
+  /// Initializing for StartParams::appearance_after_frames frames since it began, or since its last appearance start.
+  bool appearance_due(std::size_t frame) const;
+  /// Calibrates this LiDAR (`j` in `history`) by its appearance against the base's maps on the frames kept since it
+  /// began initializing; an ok result starts the calibration window from it. Only when appearance_due(frame).
+  TrackTransition start_by_appearance(const AppearanceHistory& history, const slam::LidarSetup& base, std::size_t j, std::size_t frame);
   /// Trusted -> Initializing after an extrinsic shock: hand-eye and Algorithm 1 start again; the own odometry
   /// restarts at the next scan with up from that scan's ground near the current extrinsic's.
   void restart_after_shock();
@@ -92,6 +100,8 @@ class LidarTrack {
     std::deque<std::pair<Scan, Scan>> ground;  ///< the last kGroundFrames (base, LiDAR) scans
     std::size_t rotation_only_pairs = 0;       ///< pairs added in a row with the rotation ready, not the translation
     bool after_gap = false;                    ///< a frame without a scan since the own odometry's last one
+    std::optional<std::size_t> first_frame;    ///< the frame it began at (its first step)
+    std::size_t next_appearance = 0;           ///< the frame of its next appearance start
   };
   struct Pending {
     Scan scan;
@@ -115,6 +125,7 @@ class LidarTrack {
     TranslationStart translation_start = TranslationStart::none;
     std::vector<std::string> unobservable_from_motion;
     AxisTranslationSource axis_translation_source = AxisTranslationSource::none;
+    std::vector<AppearanceAttempt> appearance;  ///< every appearance start, in order
   };
 
   std::variant<Initializing, Calibrating, Trusted> initial_state();

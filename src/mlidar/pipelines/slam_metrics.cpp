@@ -66,6 +66,29 @@ nlohmann::json covariance_terms_json(const std::optional<calib::CalibrationCovar
           {"windows", matrix_json_6(parts->windows)}};
 }
 
+/// Every appearance start of a LiDAR (slam_appearance_start.hpp).
+nlohmann::json appearance_json(const std::vector<AppearanceAttempt>& attempts) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const AppearanceAttempt& a : attempts) {
+    nlohmann::json estimate = nullptr;
+    if (a.T_base_lidar) {
+      const Quat q = a.T_base_lidar->rotation();
+      const Vec3 t = a.T_base_lidar->translation();
+      estimate = {{"translation", {t.x(), t.y(), t.z()}}, {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+    }
+    out.push_back({{"frame", a.frame},
+                   {"frames_used", a.frames_used},
+                   {"ok", a.ok},
+                   {"verdict", a.verdict},
+                   {"message", a.message},
+                   {"searched", a.searched},
+                   {"search_start", a.search_label.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.search_label)},
+                   {"estimate", estimate},
+                   {"seconds", a.seconds}});
+  }
+  return out;
+}
+
 nlohmann::json lidar_report_json(const SlamLidarReport& l) {
   const auto window_observed = [](const SlamLidarReport& r) { return r.converged_frame.has_value() || r.accepted > 0; };
   const auto& init = l.initialization;
@@ -100,7 +123,8 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
                                         ? nlohmann::json(nullptr)
                                         : nlohmann::json(to_string(l.axis_translation_source))},
         {"observable_in_window", l.unobservable_from_motion.empty() ? nlohmann::json(nullptr) : nlohmann::json(window_observed(l))},
-        {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}}}},
+        {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}},
+        {"appearance", appearance_json(l.appearance_attempts)}}},
       {"converged_frame", optional_json(l.converged_frame)},
       {"first_converged_frame", optional_json(l.first_converged_frame)},
       {"accepted", l.accepted},

@@ -2,7 +2,8 @@
 // trusted poses (eq 4.13) and screened by eq 3.4 into the online hand-eye (eq
 // 4.15-4.18), then the start of the calibration window; under planar motion
 // the height along the axis from the ground planes (eq 3.8-3.12, thesis
-// 3.4.3.1).
+// 3.4.3.1); after StartParams::appearance_after_frames without a start, the
+// appearance start (slam_appearance_start.hpp).
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -44,6 +45,45 @@ TrackTransition LidarTrack::initialize(Initializing& state, const TrackFrame& fr
   start_.unobservable_from_motion.clear();
   start_.axis_translation_source = AxisTranslationSource::none;
   if (status.state == calib::OnlineHandEyeState::ready && status.planar_motion) set_planar_height(state);
+  state_ = Calibrating{};  // `state` is gone from here on
+  return TrackTransition::started_calibration;
+}
+
+bool LidarTrack::appearance_due(std::size_t frame) const {
+  const auto* state = std::get_if<Initializing>(&state_);
+  return state != nullptr && config_->start.appearance_after_frames > 0 && state->first_frame && frame >= state->next_appearance;
+}
+
+TrackTransition LidarTrack::start_by_appearance(const AppearanceHistory& history, const slam::LidarSetup& base, std::size_t j,
+                                                std::size_t frame) {
+  auto& state = std::get<Initializing>(state_);
+  state.next_appearance = frame + config_->start.appearance_after_frames;
+  const calib::OnlineHandEyeStatus& status = state.hand_eye.status();
+  // Hand-eye's estimate is the refinement's first start (its rotation once ready; identity before any pair).
+  AppearanceAttempt attempt = appearance_start(history, *state.first_frame, base, setup_, j, status.T_base_lidar, config_->appearance);
+  attempt.frame = frame;
+  start_.appearance.push_back(attempt);
+  if (!attempt.ok) return TrackTransition::none;
+  setup_.T_base_lidar = *attempt.T_base_lidar;
+  start_.status = status;
+  start_.translation_start = TranslationStart::appearance;
+  start_.axis_translation_source = AxisTranslationSource::none;
+  start_.unobservable_from_motion.clear();
+  const auto& sv = status.singular_values;
+  if (status.pairs_stored >= config_->initialization.planar_min_pairs && sv[2] < 0.1 * sv[1]) {  // one common rotation axis
+    start_.unobservable_from_motion = {"translation along the rotation axis and rotation about it (the motion turned about one axis; "
+                                       "started from the appearance instead)"};
+  } else if (status.state == calib::OnlineHandEyeState::rotation_ready) {
+    start_.unobservable_from_motion = {"translation (the hand-eye's rotation was ready, its translation not; started from the "
+                                       "appearance instead)"};
+  } else {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "rotation and translation (%zu motion pairs of its own odometry, rotation test %.3g below sigma_R %.3g; started from the "
+                  "appearance instead)",
+                  status.pairs_stored, sv[2], config_->initialization.rotation_threshold);
+    start_.unobservable_from_motion = {text};
+  }
   state_ = Calibrating{};  // `state` is gone from here on
   return TrackTransition::started_calibration;
 }

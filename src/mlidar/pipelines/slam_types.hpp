@@ -12,6 +12,7 @@
 #include "mlidar/calib/extrinsic_covariance.hpp"
 #include "mlidar/calib/online_hand_eye.hpp"
 #include "mlidar/core/se3.hpp"
+#include "mlidar/pipelines/slam_appearance_start.hpp"
 #include "mlidar/slam/odometry.hpp"
 #include "mlidar/slam/odometry_window.hpp"
 
@@ -70,8 +71,9 @@ struct SlamFrame {
 };
 
 /// Where the calibration window's translation started at the last hand-eye start.
-enum class TranslationStart { none, hand_eye, zero };
-std::string_view to_string(TranslationStart start);  ///< "hand_eye", "zero"; "" for none
+/// appearance: from the appearance against the base's map (slam_appearance_start.hpp).
+enum class TranslationStart { none, hand_eye, zero, appearance };
+std::string_view to_string(TranslationStart start);  ///< "hand_eye", "zero", "appearance"; "" for none
 /// Planar motion: where the start's translation along the rotation axis came from.
 enum class AxisTranslationSource { none, ground_planes, set_to_zero };
 std::string_view to_string(AxisTranslationSource source);  ///< "ground planes", "set to 0"; "" for none
@@ -98,6 +100,7 @@ struct SlamLidarReport {
   std::vector<std::string> unobservable_from_motion;
   AxisTranslationSource axis_translation_source = AxisTranslationSource::none;  ///< planar motion only
   TranslationStart translation_start = TranslationStart::none;  ///< zero: not solvable from motion; none before the first start
+  std::vector<AppearanceAttempt> appearance_attempts;           ///< every appearance start, in order
 };
 
 }  // namespace mlidar::pipelines
