@@ -1,8 +1,10 @@
 #pragma once
-// Helpers shared by the tests: where the shared real data lives, scratch folders.
+// Helpers shared by the tests: where the shared real data lives, scratch folders, reading a file.
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -34,6 +36,12 @@ inline std::filesystem::path scratch_dir() {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+/// The whole file as text (empty when it cannot be opened).
+inline std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
 }
 
 }  // namespace mlidar::test

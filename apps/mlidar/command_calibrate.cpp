@@ -23,6 +23,7 @@
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/pipelines/autocalib_config.hpp"
 #include "mlidar/pipelines/autocalib_job.hpp"
+#include "mlidar/report/run_report.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -205,6 +206,7 @@ int run_auto(const AutoOptions& options, bool pair_stride_given, const CliContex
   job.max_base_gaps = options.max_base_gaps;
   job.out = run.path();
   const auto summary = pipelines::run_autocalib_job(job);
+  report::write_run_report(run.path(), {"calibrate auto", options.dataset, options.out});
   run.commit();
   print_auto_table(summary);
   std::cout << "wrote " << options.out << " (extrinsics.yaml, calibration.json) in " << summary.seconds << " s\n";

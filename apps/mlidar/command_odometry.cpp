@@ -8,6 +8,7 @@
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
+#include "mlidar/report/run_report.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -50,6 +51,7 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
   job.config = options.config;
   job.out = run.path();
   const auto summary = pipelines::run_odometry_job(job, terminal_progress_bar());
+  report::write_run_report(run.path(), {"odometry", options.dataset, options.out});
   run.commit();
   std::cout << "wrote " << options.out << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3 << " ms per frame, "
             << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost, " << summary.suspect_frames.size()

@@ -8,6 +8,7 @@
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/pipelines/slam_job.hpp"
+#include "mlidar/report/run_report.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -76,6 +77,7 @@ int run_slam(SlamOptions options, const CliContext& context) {
   job.calibrate = extrinsic_source(options.calibrate);
   job.out = run.path();
   const auto summary = pipelines::run_slam_job(job, terminal_progress_bar());
+  report::write_run_report(run.path(), {"slam", options.job.dataset, options.job.out});
   run.commit();
   std::cout << "wrote " << options.job.out.string() << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3
             << " ms per frame, " << summary.lost_frames << " lost, " << summary.suspect_frames.size() << " suspect\n";
@@ -107,7 +109,7 @@ Command register_slam(CLI::App& app, const CliContext& context) {
   sub->add_option("--threads", job->threads, "Worker threads (0: all cores)")->check(thread_count())->capture_default_str();
   add_max_base_gaps_option(*sub, job->max_base_gaps);
   sub->add_option("--out", job->out,
-                  "Run folder: trajectory.tum/.kitti, extrinsics.yaml, map.ply, metrics.json, run.json (a new or empty folder, or an "
+                  "Run folder: trajectory.tum/.kitti, extrinsics.yaml, map.ply, metrics.json, report.html, run.json (a new or empty folder, or an "
                   "earlier run)")
       ->required();
   add_overwrite_flag(*sub, options->overwrite);

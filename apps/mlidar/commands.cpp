@@ -13,7 +13,8 @@ std::vector<Command> register_commands(CLI::App& app, const CliContext& context)
           register_odometry(app, context),
           register_slam(app, context),
           register_bag(app, context),
-          register_eval(app)};
+          register_eval(app),
+          register_report(app)};
 }
 
 CLI::Validator thread_count() {

@@ -45,6 +45,12 @@ TEST(CliAutoCalib, HandheldRhdFromNoGuessAndOrderIndependent) {
   EXPECT_EQ(json["lidars"][1]["handeye"]["verdict"], "ok");
   EXPECT_GT(json["lidars"][1]["handeye"]["pairs_used"].get<int>(), 10);
   EXPECT_EQ(json["lidars"][1]["handeye"]["singular_values"].size(), 4u);
+  // report.html: the right LiDAR's verdict, and its stages against the dataset's ground truth.
+  const std::string report = read_text(run / "report.html");
+  EXPECT_NE(report.find("<li class=\"ok\">right: calibrated (ok)</li>"), std::string::npos);
+  EXPECT_NE(report.find("<section id=\"stages\">"), std::string::npos);
+  EXPECT_NE(report.find("<td>right</td><td>hand-eye</td>"), std::string::npos);
+  EXPECT_NE(report.find("error vs ground truth"), std::string::npos);
 
   const fs::path reversed = dataset_variant(sim, dir / "reversed", true, false);
   const fs::path run2 = dir / "run2";
@@ -68,6 +74,8 @@ TEST(CliAutoCalib, StaticRigIsReportedNotCalibrated) {
   const auto json = nlohmann::json::parse(std::ifstream(run / "calibration.json"));
   EXPECT_NE(json["lidars"][1]["handeye"]["verdict"], "ok");
   EXPECT_FALSE(json["all_usable"].get<bool>());
+  const std::string report = read_text(run / "report.html");
+  EXPECT_NE(report.find("<li class=\"bad\">right: " + json["lidars"][1]["verdict"].get<std::string>()), std::string::npos) << report;
   EXPECT_EQ(run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --stage polish --out " + quoted((dir / "x").string())).exit_code,
             2);
   EXPECT_EQ(run_cli("calibrate auto --dataset " + quoted(sim.string()) + " --base nosuch --out " + quoted((dir / "y").string())).exit_code,

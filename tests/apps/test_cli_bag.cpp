@@ -11,6 +11,7 @@
 #include "apps/reliability_support.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "pose_error.hpp"
+#include "test_support.hpp"
 
 namespace mlidar::test {
 namespace {

@@ -111,6 +111,19 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   EXPECT_EQ(right["first_converged_frame"], right["converged_frame"]);  // no shock here: one convergence
   // Xi_calib's autocorrelation time is at least the window's N + 1 = 5 frames (clamped to L_calib).
   EXPECT_GE(right["covariance_terms"]["autocorrelation_time"].get<double>(), 5.0);
+  EXPECT_EQ(metrics["convergence"]["lambda_calib"].get<double>(), 70.0);  // Table 4.2, what the report draws its line at
+  EXPECT_TRUE(metrics["per_frame"].back()["seconds"].contains("odometry"));
+
+  // report.html: every section, the right LiDAR's verdict, its windows against lambda_calib, the trajectory against the truth.
+  const std::string report = read_text(run / "report.html");
+  for (const char* id : {"summary", "extrinsics", "trajectory", "calibration-right", "timing"})
+    EXPECT_NE(report.find("<section id=\"" + std::string(id) + "\">"), std::string::npos) << id;
+  EXPECT_NE(report.find("<li class=\"ok\">right: calibrated online, converged at frame " + right["converged_frame"].dump()),
+            std::string::npos);
+  EXPECT_NE(report.find("lambda_calib 70"), std::string::npos);
+  EXPECT_NE(report.find("ATE (SE(3)-aligned) RMSE"), std::string::npos);
+  EXPECT_NE(report.find("<title>mlidar slam: run</title>"), std::string::npos) << "named after --out, not the staging folder";
+  EXPECT_EQ(report.find("http"), std::string::npos);
 
   // The same data with the LiDARs listed in reverse order.
   const fs::path reversed = dataset_variant(sim, dir / "reversed", true, false);
@@ -144,6 +157,7 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   EXPECT_TRUE(forced["per_frame"][first]["lidars"]["right"]["reinitialized"].get<bool>());
   EXPECT_FALSE(forced["per_frame"][first]["lidars"]["right"]["accepted"].get<bool>());
   EXPECT_EQ(forced["per_frame"][first]["lidars"]["right"]["role"], "initializing");
+  EXPECT_NE(read_text(run3 / "report.html").find("<li class=\"bad\">right: not calibrated (initializing"), std::string::npos);
 }
 
 TEST(CliSlam, FixedModeIsTheOdometryAndMissingScansAreReported) {

@@ -143,6 +143,7 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
   write_map_ply(job.out / "map.ply", std::move(map));
   nlohmann::json metrics = slam_metrics_json(run.frames, order, summary.lidars, run.load_seconds, to_string(job.calibrate));
   metrics["skipped_scans"] = gaps.json();
+  metrics["convergence"] = {{"lambda_calib", config.convergence.lambda_calib}, {"accepted_needed", config.convergence.accepted_needed}};
   const std::string text = metrics.dump(2);
   io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << text << '\n'; });
   return summary;

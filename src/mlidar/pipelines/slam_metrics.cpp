@@ -151,7 +151,8 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
   json["total_seconds"] = total;
   std::size_t lost = 0, suspect = 0, changes = 0, calibrating = 0;
   nlohmann::json per_frame = nlohmann::json::array();
-  for (const auto& f : frames) {
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const SlamFrame& f = frames[i];
     lost += f.lost ? 1 : 0;
     suspect += f.suspect ? 1 : 0;
     changes += f.trusted_changed ? 1 : 0;
@@ -164,7 +165,13 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
                          {"suspect", f.suspect},
                          {"trusted_changed", f.trusted_changed},
                          {"lidars", per_lidar},
-                         {"selection", selection_json(f.selection, f.selection_lidars)}});
+                         {"selection", selection_json(f.selection, f.selection_lidars)},
+                         {"seconds", {{"load", i < load_seconds.size() ? load_seconds[i] : 0.0},
+                                      {"odometry", f.seconds.odometry},
+                                      {"initialization", f.seconds.initialization},
+                                      {"calibration", f.seconds.calibration},
+                                      {"shock", f.seconds.shock},
+                                      {"window", f.seconds.window}}}});
   }
   json["lost_frames"] = lost;
   json["suspect_frames"] = suspect;

@@ -1,0 +1,39 @@
+#pragma once
+// The sections of report.html (run_report.hpp), each from a RunData; a
+// section the run has no data for is absent. Internal to mlidar::report.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mlidar/report/run_report.hpp"
+
+namespace mlidar::report {
+
+struct Section {
+  std::string id;  ///< the HTML id (tests and links find a section by it)
+  std::string title;
+  std::string html;  ///< its body
+};
+
+/// A table whose cells are given as HTML (escape text first).
+std::string html_table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
+
+/// Fixed-point text of `value` with `digits` decimals; "-" for a NaN.
+std::string fixed(double value, int digits);
+
+/// A number of a JSON value, NaN when it is null or not a number.
+double number_of(const nlohmann::json& value);
+
+/// {translation, quaternion_wxyz} as written by the jobs; nullopt when absent or malformed.
+std::optional<SE3> pose_of(const nlohmann::json& json);
+
+Section summary_section(const RunData& run);
+std::optional<Section> extrinsics_section(const RunData& run);
+std::optional<Section> trajectory_section(const RunData& run);
+/// One per LiDAR calibrated online (slam's per-frame windows).
+std::vector<Section> calibration_sections(const RunData& run);
+std::optional<Section> timing_section(const RunData& run);
+/// calibrate auto: hand-eye's estimate, the refinement's start and its result per LiDAR.
+std::optional<Section> autocalib_stages_section(const RunData& run);
+
+}  // namespace mlidar::report
