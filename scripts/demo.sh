@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds Release and runs mlidar's main job on the
 # built-in default: a simulated drive of the thesis's four-LiDAR vehicle (rig
-# rv, scene campus, trajectory vehicle, 100 frames, seed 1), then multi-LiDAR
-# odometry on it, evaluated against the simulator's ground truth. Everything
-# goes to ./mlidar_demo (or the folder given as the first argument).
+# rv, scene campus, trajectory vehicle, 100 frames, seed 1), then `mlidar slam`
+# on it (odometry from all four LiDARs with the three others calibrated online),
+# evaluated against the simulator's ground truth, with its report.html.
+# Everything goes to ./mlidar_demo (or the folder given as the first argument).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out=${1:-"$PWD/mlidar_demo"}
@@ -17,7 +18,8 @@ mkdir -p "$out"
 dataset="$out/dataset"
 rm -rf "$dataset"  # the demo's own output from an earlier run
 echo "== simulating the default multi-LiDAR drive into $dataset"
-"$mlidar" simulate drive --rig rv --scene campus --trajectory vehicle --frames 100 --seed 1 --out "$dataset"
+"$mlidar" simulate drive --rig rv --scene campus --trajectory vehicle --frames 100 --seed 1 --encoding binary_compressed \
+  --out "$dataset"
 
 echo "== what was written"
 for lidar_dir in "$dataset"/scans/*/; do
@@ -29,10 +31,11 @@ echo "  size: $(du -sh "$dataset" | cut -f1)"
 echo "== first scan of the top LiDAR"
 "$mlidar" info "$dataset/scans/top/000000.pcd"
 
-run="$out/odometry"
+run="$out/slam"
 rm -rf "$run"
-echo "== multi-LiDAR odometry (all four LiDARs at once) into $run"
-"$mlidar" odometry --dataset "$dataset" --out "$run"
-echo "== accuracy against the ground truth (plot: $run/trajectory.svg)"
-"$mlidar" eval traj --gt "$dataset/groundtruth/trajectory.tum" --est "$run/trajectory.tum" \
-  --json "$run/eval.json" --plot "$run/trajectory.svg"
+echo "== M-LOAM: odometry from all four LiDARs at once, calibrating the three others online, into $run"
+"$mlidar" slam --dataset "$dataset" --out "$run"
+echo "== accuracy against the ground truth"
+"$mlidar" eval traj --gt "$dataset/groundtruth/trajectory.tum" --est "$run/trajectory.tum" --json "$run/eval.json"
+"$mlidar" eval calib --gt "$dataset/groundtruth/extrinsics.yaml" --est "$run/extrinsics.yaml" --json "$run/calib.json"
+echo "== the report (open it in a browser): $run/report.html"

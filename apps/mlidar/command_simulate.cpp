@@ -8,6 +8,7 @@
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/pcd.hpp"
 #include "mlidar/io/run_folder.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/sim/corner_dataset.hpp"
@@ -23,6 +24,7 @@ struct DriveOptions {
   int frames = 100;
   std::uint64_t seed = 1;
   std::string perturb = "0,0";
+  std::string encoding = "binary";
   bool overwrite = false;
   std::string out;
 };
@@ -74,6 +76,7 @@ int run_drive(const DriveOptions& options, const CliContext& context) {
   spec.seed = options.seed;
   spec.perturb_deg = perturb[0];
   spec.perturb_m = perturb[1];
+  spec.encoding = io::pcd_encoding_from_name(options.encoding);
   sim::write_drive_dataset(spec, run.path(), terminal_progress_bar());
   run.commit();
   std::cout << "wrote " << options.out << ": " << spec.frames << " frames of " << spec.rig.lidars.size() << " LiDAR(s), rig "
@@ -108,6 +111,9 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
   drive_cmd->add_option("--frames", drive->frames, "Number of frames")->check(CLI::Range(1, 1000000))->capture_default_str();
   drive_cmd->add_option("--seed", drive->seed, "Random seed (same seed, same bytes)")->capture_default_str();
   drive_cmd->add_option("--perturb", drive->perturb, "Perturb the initial extrinsics: DEG,M")->capture_default_str();
+  drive_cmd->add_option("--encoding", drive->encoding, "PCD encoding of the scans (binary_compressed: about a third smaller)")
+      ->check(CLI::IsMember({"binary", "binary_compressed"}))
+      ->capture_default_str();
   drive_cmd->add_option("--out", drive->out, "Dataset folder (a new or empty folder, or an earlier simulate output)")->required();
   add_overwrite_flag(*drive_cmd, drive->overwrite);
 

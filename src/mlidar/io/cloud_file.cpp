@@ -55,13 +55,6 @@ CloudFormat sniff_format(std::span<const std::byte> bytes) {
   return CloudFormat::kKittiBin;
 }
 
-PcdEncoding parse_pcd_encoding(const std::string& name) {
-  if (name == "binary") return PcdEncoding::kBinary;
-  if (name == "binary_compressed") return PcdEncoding::kBinaryCompressed;
-  if (name == "ascii") return PcdEncoding::kAscii;
-  throw UsageError("unknown PCD encoding '" + name + "' (use binary, binary_compressed or ascii)");
-}
-
 PointTable without_padding(const PointTable& table) {
   PointTable out;
   out.num_points = table.num_points;
@@ -119,7 +112,7 @@ void write_cloud(const std::filesystem::path& path, const CloudFile& cloud, cons
   switch (cloud_format_of(path)) {
     case CloudFormat::kPcd: {
       PcdCloud pcd;
-      pcd.encoding = parse_pcd_encoding(options.pcd_encoding);
+      pcd.encoding = pcd_encoding_from_name(options.pcd_encoding);
       pcd.viewpoint = cloud.viewpoint;
       pcd.table = cloud.table;
       write_pcd(path, pcd);

@@ -15,6 +15,8 @@ namespace mlidar::io {
 
 enum class PcdEncoding : std::uint8_t { kAscii, kBinary, kBinaryCompressed };
 const char* pcd_encoding_name(PcdEncoding encoding);  ///< "ascii", "binary", "binary_compressed"
+/// The inverse of pcd_encoding_name; UsageError (exit 2) for another name.
+PcdEncoding pcd_encoding_from_name(const std::string& name);
 
 struct PcdCloud {
   std::string version = "0.7";

@@ -134,6 +134,13 @@ void append_compressed_body(const PointTable& table, std::vector<std::byte>& out
 
 }  // namespace
 
+PcdEncoding pcd_encoding_from_name(const std::string& name) {
+  if (name == "binary") return PcdEncoding::kBinary;
+  if (name == "binary_compressed") return PcdEncoding::kBinaryCompressed;
+  if (name == "ascii") return PcdEncoding::kAscii;
+  throw UsageError("unknown PCD encoding '" + name + "' (use binary, binary_compressed or ascii)");
+}
+
 const char* pcd_encoding_name(PcdEncoding encoding) {
   switch (encoding) {
     case PcdEncoding::kAscii:

@@ -123,6 +123,7 @@ void write_drive_dataset(const DriveSpec& spec, const fs::path& out, const Progr
         if (id > 0) seen.insert(id);
       }
       io::PcdCloud cloud;
+      cloud.encoding = spec.encoding;
       cloud.table = io::from_scan(sweep.scan);
       io::write_pcd(dir / "scans" / lidar.name / frame_file(frame, ".pcd"), cloud);
     }
