@@ -11,6 +11,8 @@
 
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/cloud_file.hpp"
+#include "mlidar/io/point_table.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/report/run_report.hpp"
 #include "test_support.hpp"
@@ -91,6 +93,13 @@ Fixture make_run(bool with_run_json) {
   io::write_tum(f.run / "trajectory.tum", straight_line(1.0, 0.0));
   io::write_tum(f.dataset / "groundtruth" / "trajectory.tum", straight_line(1.02, 0.0));
   std::ofstream(f.run / "metrics.json") << slam_metrics(f.T_right_estimate).dump();
+  // A map: a 10 x 4 m floor at z = 0 and one post 2 m high at (5, 2).
+  Scan map;
+  for (int i = 0; i <= 100; ++i)
+    for (int j = 0; j <= 40; ++j) map.points.emplace_back(0.1f * i, 0.1f * j, 0.0f);
+  for (int k = 0; k < 200; ++k) map.points.emplace_back(5.0f, 2.0f, 0.01f * k);
+  io::write_cloud(f.run / "map.ply",
+                  io::CloudFile{io::CloudFormat::kPly, "binary_little_endian", {0, 0, 0, 1, 0, 0, 0}, io::from_scan(map)});
   if (with_run_json)
     std::ofstream(f.run / "run.json") << nlohmann::json{
         {"tool", "mlidar"},
@@ -113,7 +122,7 @@ TEST(RunReport, HasTheSectionsItsDataAllowWithVerdictsInWords) {
   const RunData run = load_run(f.run);  // the dataset from run.json's --dataset
   ASSERT_TRUE(run.gt_trajectory && run.gt_extrinsics) << (run.notes.empty() ? "" : run.notes.front());
   const std::string html = render_report_html(run);
-  for (const char* id : {"summary", "extrinsics", "trajectory", "calibration-right", "timing"})
+  for (const char* id : {"summary", "extrinsics", "trajectory", "map", "calibration-right", "timing"})
     EXPECT_FALSE(section(html, id).empty()) << id;
   EXPECT_TRUE(section(html, "calibration-left").empty()) << "no window, no calibration section";
   const std::string summary = section(html, "summary");
@@ -130,6 +139,11 @@ TEST(RunReport, HasTheSectionsItsDataAllowWithVerdictsInWords) {
   std::snprintf(expected, sizeof expected, "<td>1.000 / 2.00</td><td>%.2f</td>", nees);
   EXPECT_NE(extrinsics.find(expected), std::string::npos) << expected << "\n" << extrinsics;
   EXPECT_NE(section(html, "trajectory").find("ATE (SE(3)-aligned) RMSE"), std::string::npos);
+  // The map: the floor in the lowest colour, the post's cell in the highest (heights clipped to the 2nd-98th percentile).
+  const std::string map = section(html, "map");
+  EXPECT_NE(map.find("4341 points"), std::string::npos) << map.substr(0, 300);
+  EXPECT_NE(map.find("fill=\"#440154\""), std::string::npos) << "floor: the bottom of the scale";
+  EXPECT_NE(map.find("fill=\"#fde725\""), std::string::npos) << "post: the top of the scale";
   EXPECT_EQ(html.find("http"), std::string::npos) << "nothing to fetch, no namespace URL either";
   EXPECT_EQ(html.find("<script"), std::string::npos);
   EXPECT_EQ(render_report_html(load_run(f.run)), html) << "the same folder gives the same bytes";

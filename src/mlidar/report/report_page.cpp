@@ -53,6 +53,7 @@ std::vector<Section> all_sections(const RunData& run) {
   std::vector<Section> sections{summary_section(run)};
   if (auto s = extrinsics_section(run)) sections.push_back(std::move(*s));
   if (auto s = trajectory_section(run)) sections.push_back(std::move(*s));
+  if (auto s = map_section(run)) sections.push_back(std::move(*s));
   if (auto s = autocalib_stages_section(run)) sections.push_back(std::move(*s));
   for (Section& s : calibration_sections(run)) sections.push_back(std::move(s));
   if (auto s = timing_section(run)) sections.push_back(std::move(*s));

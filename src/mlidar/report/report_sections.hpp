@@ -33,6 +33,8 @@ std::optional<Section> trajectory_section(const RunData& run);
 /// One per LiDAR calibrated online (slam's per-frame windows).
 std::vector<Section> calibration_sections(const RunData& run);
 std::optional<Section> timing_section(const RunData& run);
+/// The map's top view coloured by height.
+std::optional<Section> map_section(const RunData& run);
 /// calibrate auto: hand-eye's estimate, the refinement's start and its result per LiDAR.
 std::optional<Section> autocalib_stages_section(const RunData& run);
 

@@ -2,7 +2,9 @@
 #include <system_error>
 
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/file_bytes.hpp"
+#include "mlidar/io/point_table.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/report/run_report.hpp"
 
@@ -74,6 +76,9 @@ RunData load_run(const fs::path& folder, const ReportSource& source) {
       folder / "trajectory.tum", [](const fs::path& p) { return io::read_tum(p); }, run.notes);
   run.extrinsics = read_optional<io::Extrinsics>(
       folder / "extrinsics.yaml", [](const fs::path& p) { return io::read_extrinsics(p); }, run.notes);
+  if (auto points = read_optional<std::vector<Eigen::Vector3f>>(
+          folder / "map.ply", [](const fs::path& p) { return io::to_scan(io::read_cloud(p).table, p.string()).points; }, run.notes))
+    run.map = std::move(*points);
   run.dataset = !source.dataset.empty() ? source.dataset.string() : dataset_argument(run.run_info);
   if (run.dataset.empty()) return run;
   const fs::path truth = fs::path(run.dataset) / "groundtruth";

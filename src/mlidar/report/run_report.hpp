@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include "mlidar/core/types.hpp"
@@ -30,6 +31,7 @@ struct RunData {
   nlohmann::json metrics;    ///< metrics.json or calibration.json (null when absent)
   std::optional<Trajectory> trajectory;
   std::optional<io::Extrinsics> extrinsics;
+  std::vector<Eigen::Vector3f> map;             ///< map.ply's points (empty when absent)
   std::optional<Trajectory> gt_trajectory;      ///< DATASET/groundtruth/trajectory.tum
   std::optional<io::Extrinsics> gt_extrinsics;  ///< DATASET/groundtruth/extrinsics.yaml
   std::vector<std::string> notes;               ///< what could not be read, in words

@@ -100,6 +100,26 @@ void draw_series(const Series& s, const Mapper& map, std::ostringstream& out) {
   flush();
 }
 
+void draw_raster(const Raster& r, const Mapper& map, std::ostringstream& out) {
+  if (r.columns <= 0 || r.rows <= 0 || r.colours.size() != static_cast<std::size_t>(r.columns) * static_cast<std::size_t>(r.rows)) return;
+  const double height = r.cell * map.layout.y_scale();
+  out << "<g shape-rendering=\"crispEdges\">";
+  for (int row = 0; row < r.rows; ++row) {
+    const double top = map.v(r.y0 + (row + 1) * r.cell);
+    for (int c = 0; c < r.columns;) {
+      const std::string& colour = r.colours[static_cast<std::size_t>(row) * r.columns + c];
+      int end = c + 1;
+      while (end < r.columns && r.colours[static_cast<std::size_t>(row) * r.columns + end] == colour) ++end;
+      if (!colour.empty())
+        out << "<rect x=\"" << coordinate(map.u(r.x0 + c * r.cell)) << "\" y=\"" << coordinate(top) << "\" width=\""
+            << coordinate((end - c) * r.cell * map.layout.x_scale() + 0.05) << "\" height=\"" << coordinate(height + 0.05) << "\" fill=\""
+            << escape_markup(colour) << "\"/>";
+      c = end;
+    }
+  }
+  out << "</g>\n";
+}
+
 void draw_band(const Band& b, const Mapper& map, std::ostringstream& out) {
   const std::size_t n = std::min({b.x.size(), b.lo.size(), b.hi.size()});
   const std::vector<std::size_t> drawn = drawn_indices(n);
@@ -240,6 +260,12 @@ ChartLayout layout_chart(const Chart& chart) {
     for (const double v : b.hi) y.add(shown_y(chart, v));
   }
   for (const ReferenceLine& r : chart.lines) y.add(shown_y(chart, r.y));
+  if (chart.raster.columns > 0 && chart.raster.rows > 0) {
+    x.add(chart.raster.x0);
+    x.add(chart.raster.x0 + chart.raster.columns * chart.raster.cell);
+    y.add(chart.raster.y0);
+    y.add(chart.raster.y0 + chart.raster.rows * chart.raster.cell);
+  }
   x = x.padded(chart.equal_axes ? 0.05 : 0.0);
   y = y.padded(0.05);
   if (chart.equal_axes) equalise(layout, x, y);
@@ -260,6 +286,7 @@ std::string render_svg(const Chart& chart) {
   out << "<text x=\"" << kMarginLeft << "\" y=\"16\" font-size=\"13\" font-weight=\"bold\">" << escape_markup(chart.title) << "</text>\n";
   draw_legend(chart, out);
   draw_grid(chart, layout, map, out);
+  draw_raster(chart.raster, map, out);
   for (const Band& b : chart.bands) draw_band(b, map, out);
   for (const ReferenceLine& r : chart.lines) {
     const double v = map.v(r.y);

@@ -29,12 +29,22 @@ struct ReferenceLine {
   std::string colour = "#555";
 };
 
+/// A grid of coloured cells in data units (a map's top view): cell (c, r)
+/// covers [x0 + c cell, x0 + (c + 1) cell) x [y0 + r cell, ...); an empty
+/// colour leaves the cell blank. Runs of equal colour along a row are drawn as one rect.
+struct Raster {
+  double x0 = 0.0, y0 = 0.0, cell = 1.0;
+  int columns = 0, rows = 0;
+  std::vector<std::string> colours;  ///< rows x columns, row-major, row 0 at y0
+};
+
 struct Chart {
   std::string title;
   std::string x_label, y_label;  ///< with units, e.g. "x (m)"
   std::vector<Series> series;
   std::vector<Band> bands;
   std::vector<ReferenceLine> lines;
+  Raster raster;            ///< drawn under the series; empty when columns or rows is 0
   bool equal_axes = false;  ///< one unit has the same length on both axes; adds a scale bar
   bool log_y = false;       ///< y on a log10 scale; values <= 0 are left out
   double width = 640, height = 360;

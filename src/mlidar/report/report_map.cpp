@@ -1,0 +1,97 @@
+// The map section of report.html: map.ply seen from above, each cell of a
+// grid coloured by the highest point in it (heights clipped to the 2nd-98th
+// percentile so a few stray points do not wash out the colours).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "mlidar/report/report_sections.hpp"
+#include "mlidar/report/svg_chart.hpp"
+
+namespace mlidar::report {
+namespace {
+
+constexpr int kLongSideCells = 320;  ///< cells along the map's longer side
+constexpr int kColourLevels = 24;    ///< heights are binned so runs of one colour merge into one rect
+
+/// A perceptually ordered dark-blue to yellow scale (anchors of viridis), t in [0, 1].
+std::string height_colour(double t) {
+  static constexpr std::array<std::array<double, 3>, 5> kAnchors{
+      {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+  const double at = std::clamp(t, 0.0, 1.0) * (kAnchors.size() - 1);
+  const auto i = std::min<std::size_t>(static_cast<std::size_t>(at), kAnchors.size() - 2);
+  const double f = at - static_cast<double>(i);
+  char text[8];
+  std::snprintf(text, sizeof text, "#%02x%02x%02x",
+                static_cast<int>(std::lround(kAnchors[i][0] + f * (kAnchors[i + 1][0] - kAnchors[i][0]))),
+                static_cast<int>(std::lround(kAnchors[i][1] + f * (kAnchors[i + 1][1] - kAnchors[i][1]))),
+                static_cast<int>(std::lround(kAnchors[i][2] + f * (kAnchors[i + 1][2] - kAnchors[i][2]))));
+  return text;
+}
+
+double percentile(std::vector<float> values, double share) {
+  const auto k = static_cast<std::size_t>(share * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+}  // namespace
+
+std::optional<Section> map_section(const RunData& run) {
+  std::vector<Eigen::Vector3f> points;
+  for (const Eigen::Vector3f& p : run.map)
+    if (p.allFinite()) points.push_back(p);
+  if (points.size() < 10) return std::nullopt;
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
+  std::vector<float> heights;
+  for (const Eigen::Vector3f& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+    heights.push_back(p.z());
+  }
+  const double z_lo = percentile(heights, 0.02), z_hi = std::max(percentile(heights, 0.98), z_lo + 1e-3);
+  Raster raster;
+  raster.cell = std::max(static_cast<double>(std::max(hi.x() - lo.x(), hi.y() - lo.y())) / kLongSideCells, 0.05);
+  raster.x0 = lo.x();
+  raster.y0 = lo.y();
+  raster.columns = static_cast<int>(std::floor((hi.x() - lo.x()) / raster.cell)) + 1;
+  raster.rows = static_cast<int>(std::floor((hi.y() - lo.y()) / raster.cell)) + 1;
+  std::vector<float> top(static_cast<std::size_t>(raster.columns) * raster.rows, -std::numeric_limits<float>::infinity());
+  for (const Eigen::Vector3f& p : points) {
+    const int c = std::min(raster.columns - 1, static_cast<int>((p.x() - raster.x0) / raster.cell));
+    const int r = std::min(raster.rows - 1, static_cast<int>((p.y() - raster.y0) / raster.cell));
+    float& cell = top[static_cast<std::size_t>(r) * raster.columns + c];
+    cell = std::max(cell, p.z());
+  }
+  raster.colours.resize(top.size());
+  for (std::size_t i = 0; i < top.size(); ++i) {
+    if (!std::isfinite(top[i])) continue;
+    const double t = (top[i] - z_lo) / (z_hi - z_lo);
+    raster.colours[i] = height_colour(std::round(std::clamp(t, 0.0, 1.0) * (kColourLevels - 1)) / (kColourLevels - 1));
+  }
+  Chart chart;
+  chart.title = "Map, top view (highest point per cell)";
+  chart.x_label = "x (m)";
+  chart.y_label = "y (m)";
+  chart.equal_axes = true;
+  chart.width = 900;
+  chart.height = 640;
+  chart.raster = std::move(raster);
+  if (run.trajectory) {  // the estimate as written, in the map's frame
+    Series path{"trajectory", "#ff3030", {}, {}};
+    for (const StampedPose& pose : run.trajectory->poses) {
+      path.x.push_back(pose.T_world_base.translation().x());
+      path.y.push_back(pose.T_world_base.translation().y());
+    }
+    chart.series.push_back(std::move(path));
+  }
+  const std::string html =
+      "<p>map.ply, " + std::to_string(points.size()) + " points in the frame of trajectory.tum (drawn in red); cells of " +
+      fixed(chart.raster.cell, 2) + " m coloured by height from " + fixed(z_lo, 2) + " m (<span style=\"color:" + height_colour(0.0) +
+      "\">dark blue</span>) to " + fixed(z_hi, 2) + " m (<span style=\"color:#b8a000\">yellow</span>).</p>\n" + render_svg(chart);
+  return Section{"map", "Map", html};
+}
+
+}  // namespace mlidar::report
