@@ -10,7 +10,8 @@ packages=(
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev liblzf-dev
   libbz2-dev liblz4-dev libzstd-dev libsqlite3-dev
   python3-yaml python3-rosbag python3-sensor-msgs python3-tf2-msgs python3-roslz4 python3-zstandard python3-lz4
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev
+  chromium fonts-liberation
 )
 
 missing=()
