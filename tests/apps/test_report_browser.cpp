@@ -43,7 +43,7 @@ Rendered render(const fs::path& page, int width, int height, const fs::path& wor
   const fs::path png = work / (name + ".png"), net = work / (name + ".json");
   const CliResult result = run_shell(quoted(chromium()) +
                                      " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking"
-                                     " --disable-component-update --disable-sync --enable-logging=stderr --v=0 --user-data-dir=" +
+                                     " --disable-component-update --disable-sync --disable-dev-shm-usage --enable-logging=stderr --v=0 --user-data-dir=" +
                                      quoted((work / (name + "-profile")).string()) + " --log-net-log=" + quoted(net.string()) +
                                      " --window-size=" + std::to_string(width) + "," + std::to_string(height) +
                                      " --screenshot=" + quoted(png.string()) + " " + quoted("file://" + fs::absolute(page).string()));
