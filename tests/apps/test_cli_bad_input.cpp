@@ -75,6 +75,12 @@ TEST_P(CliBadInput, IsExitThreeNamingFileAndFieldAndWritesNothing) {
     EXPECT_FALSE(fs::exists(dir / "run"));
     EXPECT_TRUE(entries_containing(dir, ".mlidar-stage-").empty());
   }
+  // `doctor` finds it before a run, with the same message (exit 1: a run would fail).
+  const CliResult doctor = run_cli("doctor " + quoted(data.string()));
+  EXPECT_EQ(doctor.exit_code, 1) << doctor.output;
+  EXPECT_NE(doctor.output.find("failure"), std::string::npos) << doctor.output;
+  EXPECT_NE(doctor.output.find((data / bad.file).string()), std::string::npos) << doctor.output;
+  EXPECT_NE(doctor.output.find(bad.field), std::string::npos) << doctor.output;
   EXPECT_EQ(folder_checksums(data), before);
   EXPECT_EQ(folder_checksums(previous), previous_before);
 }
@@ -230,6 +236,60 @@ TEST(CliDeterminism, RunsAreByteIdenticalExceptTimingWhateverTheThreads) {
       EXPECT_EQ(read_text(dir / "a" / file), read_text(dir / other / file)) << file << " of run " << other;
     EXPECT_EQ(metrics("a"), metrics(other)) << other;
   }
+}
+
+/// The finding line of `check` (and LiDAR) in doctor's output, or empty.
+std::string finding(const std::string& output, const std::string& check) {
+  const std::size_t at = output.find("  " + check + ": ");
+  if (at == std::string::npos) return {};
+  const std::size_t start = output.rfind('\n', at) == std::string::npos ? 0 : output.rfind('\n', at) + 1;
+  return output.substr(start, output.find('\n', at) - start);
+}
+
+TEST(CliDoctor, NamesWhatWouldMisleadARunWithItsFixAndExitsOneOnlyForFailures) {
+  const fs::path dir = scratch_dir();
+  CliResult clean = run_cli("doctor " + quoted(small_dataset().string()) + " --json " + quoted((dir / "clean.json").string()));
+  EXPECT_EQ(clean.exit_code, 0) << clean.output;
+  EXPECT_EQ(clean.output.find("warning"), std::string::npos) << clean.output;
+  EXPECT_NE(finding(clean.output, "overlap right").rfind("ok", 0), std::string::npos) << clean.output;
+  const nlohmann::json json = nlohmann::json::parse(std::ifstream(dir / "clean.json"));
+  EXPECT_FALSE(json["failed"].get<bool>());
+  EXPECT_GE(json["findings"].size(), 8u);
+
+  const fs::path data = copy_of_small_dataset(dir / "data");
+  replace_scan(data / "scans/right/000005.pcd", 0, 0);       // empty: skipped by the jobs
+  replace_scan(data / "scans/right/000007.pcd", 50, 3);      // no per-point time
+  Scan mixed;  // half its points on a ring beyond the VLP-16's 16, no per-point time either
+  for (int i = 0; i < 60; ++i) {
+    mixed.points.emplace_back(5.0F, 0.01F * static_cast<float>(i), 0.0F);
+    mixed.ring.push_back(i % 2 == 0 ? 3 : 20);
+  }
+  io::write_cloud(data / "scans/right/000008.pcd", io::CloudFile{io::CloudFormat::kPcd, "binary", {0, 0, 0, 1, 0, 0, 0}, io::from_scan(mixed)});
+  edit_yaml(data, "translation: [0, -0.477, -0.22]", "translation: [0, -477, -220]");  // millimetres
+  std::istringstream in(read_text(data / "times.txt"));  // a 1 s hole before frame 9
+  std::string stamps, line;
+  for (int k = 0; std::getline(in, line); ++k) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.9f", std::stod(line) + (k >= 9 ? 1.0 : 0.0));
+    stamps += std::string(text) + "\n";
+  }
+  write_text(data / "times.txt", stamps);
+  const CliResult r = run_cli("doctor " + quoted(data.string()));
+  EXPECT_EQ(r.exit_code, 0) << "warnings only\n" << r.output;
+  EXPECT_NE(finding(r.output, "stamps").find("1 gap(s)"), std::string::npos) << r.output;
+  EXPECT_NE(finding(r.output, "stamps").find("frame(s) 9"), std::string::npos) << r.output;
+  EXPECT_NE(finding(r.output, "scans right").find("frame 5"), std::string::npos) << r.output;
+  EXPECT_NE(finding(r.output, "time right").find("2 of 11 scans without per-point times"), std::string::npos) << r.output;
+  EXPECT_NE(finding(r.output, "rings right").find("ring values reach 20 for a model of 16 rows"), std::string::npos) << r.output;
+  EXPECT_NE(finding(r.output, "extrinsics right").find("check the units"), std::string::npos) << r.output;
+  EXPECT_NE(finding(r.output, "overlap right").rfind("warning", 0), std::string::npos) << r.output;
+
+  // The base losing most of its scans: a failure, exit 1.
+  for (int k = 0; k < 6; ++k) replace_scan(data / "scans/left" / ("00000" + std::to_string(k) + ".pcd"), 0, 0);
+  const CliResult base = run_cli("doctor " + quoted(data.string()));
+  EXPECT_EQ(base.exit_code, 1) << base.output;
+  EXPECT_NE(finding(base.output, "scans left").find("the base LiDAR lacks a usable scan in 6 of 12 frames"), std::string::npos) << base.output;
+  EXPECT_EQ(run_cli("doctor " + quoted((dir / "nothing").string())).exit_code, 2) << "no such input: usage";
 }
 
 }  // namespace
