@@ -56,6 +56,7 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
   std::cout << "wrote " << options.out << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3 << " ms per frame, "
             << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost, " << summary.suspect_frames.size()
             << " suspect\n";
+  for (const auto& line : summary.front_end) std::cout << "note: " << line << '\n';
   if (summary.degenerate_frames > 0)
     std::cerr << "warning: " << summary.degenerate_frames
               << " frame(s) degenerate (translation weakly constrained, e.g. a corridor); see metrics.json\n";

@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 51u);
+  EXPECT_EQ(slam_config_keys().size(), 52u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -125,7 +125,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  relative_to_others: false\n"
       "odometry:\n"
       "  plane_voxel_m: 0.7\n  edge_voxel_m: 0.3\n  local_map_radius_m: 80\n  max_iterations: 12\n  refine_deskew: true\n"
-      "  deskew_in_registration: false\n  huber_delta_m: 0.05\n"
+      "  deskew_in_registration: false\n  huber_delta_m: 0.05\n  recover_rows: false\n"
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
       "  degeneracy_interval_s: 2\n  epsilon: 0.4\n  time_budget_ms: 3\n  seed: 12\n  min_features: 40\n"
@@ -190,6 +190,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(sel.held_out_residual_ratio, 2.0);
   EXPECT_EQ(sel.held_out_residual_floor_m, 0.02);
   EXPECT_EQ(c.odometry.registration.huber_delta_m, 0.05);
+  EXPECT_FALSE(c.odometry.front_end.recover_rows);
 }
 
 struct Rejection {

@@ -1,5 +1,6 @@
 #include "mlidar/pipelines/odometry_job.hpp"
 
+#include <algorithm>
 #include <memory>
 
 #include <tbb/global_control.h>
@@ -42,6 +43,35 @@ Frame odometry_frame(const io::SourceFrame& source) {
   return frame;
 }
 
+/// For each LiDAR without a model: how its features were made, in words.
+std::vector<std::string> front_end_lines(const std::vector<slam::FrameResult>& results, const std::vector<slam::LidarSetup>& lidars) {
+  std::vector<std::string> lines;
+  for (std::size_t i = 0; i < lidars.size(); ++i) {
+    if (!lidars[i].model.vertical_angles_deg.empty()) continue;
+    std::vector<int> rows;
+    std::size_t fallback = 0;
+    for (const slam::FrameResult& r : results) {
+      if (i >= r.lidar_row_source.size()) continue;
+      if (r.lidar_row_source[i] == slam::RowSource::kRecovered) rows.push_back(r.lidar_rows[i]);
+      fallback += r.lidar_row_source[i] == slam::RowSource::kVoxelFallback ? 1 : 0;
+    }
+    std::string line = "LiDAR '" + lidars[i].name + "' has no model: ";
+    if (!rows.empty()) {
+      std::sort(rows.begin(), rows.end());
+      line += "scan rows recovered in " + std::to_string(rows.size()) + " of " + std::to_string(results.size()) + " frames (" +
+              std::to_string(rows[rows.size() / 2]) + " rows, median), features from their range images; ";
+    }
+    if (fallback > 0)
+      line += std::to_string(fallback) +
+              " frame(s) showed no scan rows (a solid-state scanner, or keyframes merged from sweeps "
+              "taken while moving) and used 0.5 m voxel samples as plane features (metrics.json front_end)";
+    else
+      line += "every frame";
+    lines.push_back(line);
+  }
+  return lines;
+}
+
 }  // namespace
 
 OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<void(int, int)>& progress) {
@@ -74,6 +104,7 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
     for (const double s : r.seconds) summary.mean_frame_seconds += s / static_cast<double>(results.size());
   }
   summary.gaps = gaps.summary_lines();
+  summary.front_end = front_end_lines(results, lidars);
   summary.base_failure = gaps.base_failure(job.max_base_gaps, source.reference_index());
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);

@@ -9,7 +9,9 @@
 //   metrics.json      per-stage seconds per frame (mean/p50/p95/max), points
 //                     in/out, smallest eigenvalues and observability per
 //                     frame, degenerate, retried and lost frame counts,
-//                     skipped_scans (frame_gaps.hpp)
+//                     skipped_scans (frame_gaps.hpp), front_end (per LiDAR:
+//                     frames whose rows came from the model, were recovered
+//                     from the scan, or fell back to voxel samples)
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -45,6 +47,7 @@ struct OdometryJobSummary {
   double mean_frame_seconds = 0.0;
   Trajectory trajectory;
   std::vector<std::string> gaps;            ///< per LiDAR with skipped or missing scans, in words
+  std::vector<std::string> front_end;       ///< per LiDAR without a model: rows recovered or voxel samples, in words
   std::optional<std::string> base_failure;  ///< the base LiDAR lacked too many frames (exit 1)
 };
 

@@ -45,6 +45,26 @@ nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summa
           {"per_lidar", per_lidar}};
 }
 
+namespace {
+
+/// Per LiDAR: in how many frames its rows came from the model, were recovered (and how many), or the voxel fallback ran.
+nlohmann::json front_end_summary(const std::vector<std::string>& names, std::size_t frames,
+                                 const std::vector<std::vector<int>>& recovered_rows, const std::vector<std::size_t>& fallback_frames) {
+  nlohmann::json summary = nlohmann::json::object();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::vector<int> rows = recovered_rows[i];
+    std::sort(rows.begin(), rows.end());
+    nlohmann::json recovered = {{"frames", rows.size()}};
+    if (!rows.empty()) recovered.update({{"rows_min", rows.front()}, {"rows_median", rows[rows.size() / 2]}, {"rows_max", rows.back()}});
+    summary[names[i]] = {{"model_frames", frames - rows.size() - fallback_frames[i]},
+                         {"recovered", recovered},
+                         {"voxel_fallback_frames", fallback_frames[i]}};
+  }
+  return summary;
+}
+
+}  // namespace
+
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars) {
   nlohmann::json json;
   json["frames"] = frames.size();
@@ -59,7 +79,15 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
     json["stages"][slam::stage_name(static_cast<slam::Stage>(s))] = timing_summary(stage);
   }
   nlohmann::json per_frame = nlohmann::json::array();
+  std::vector<std::vector<int>> recovered_rows(names.size());
+  std::vector<std::size_t> fallback_frames(names.size(), 0);
   for (const auto& f : frames) {
+    nlohmann::json front_end;
+    for (std::size_t i = 0; i < names.size() && i < f.lidar_rows.size(); ++i) {
+      front_end[names[i]] = {{"rows", f.lidar_rows[i]}, {"source", slam::row_source_name(f.lidar_row_source[i])}};
+      if (f.lidar_row_source[i] == slam::RowSource::kRecovered) recovered_rows[i].push_back(f.lidar_rows[i]);
+      fallback_frames[i] += f.lidar_row_source[i] == slam::RowSource::kVoxelFallback ? 1 : 0;
+    }
     double sum = 0.0;
     for (const double v : f.seconds) sum += v;
     total.push_back(sum);
@@ -86,6 +114,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
                          {"threshold_m", f.threshold_m},
                          {"edges", f.edge_features},
                          {"planes", f.plane_features},
+                         {"front_end", front_end},
                          {"selection", selection_json(f.selection_summary(), names)}});
   }
   json["total_seconds"] = timing_summary(total);
@@ -95,6 +124,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["retried_frames"] = retried;
   json["lost_frames"] = lost;
   json["suspect_frames"] = suspect;
+  json["front_end"] = front_end_summary(names, frames.size(), recovered_rows, fallback_frames);
   json["per_frame"] = std::move(per_frame);
   return json;
 }

@@ -65,6 +65,18 @@ const char* stage_name(Stage stage) {
   return "unknown";
 }
 
+const char* row_source_name(RowSource source) {
+  switch (source) {
+    case RowSource::kModel:
+      return "model";
+    case RowSource::kRecovered:
+      return "recovered";
+    case RowSource::kVoxelFallback:
+      return "voxel_fallback";
+  }
+  return "unknown";
+}
+
 std::vector<std::uint32_t> voxel_subsample(std::span<const Eigen::Vector3f> points, double voxel_m) {
   tsl::robin_set<VoxelKey, VoxelKeyHash> seen;
   std::vector<std::uint32_t> kept;
@@ -83,7 +95,21 @@ void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& l
                    const FrontEndConfig& config, FrontEndWorkspace& ws, LidarFeatures& out, StageSeconds& seconds) {
   std::vector<float> shifted;
   const std::span<const float> times = times_from_reference(scan, reference_stamp, shifted);
-  if (lidar.model.vertical_angles_deg.empty()) {
+  const LidarModel* model = &lidar.model;
+  std::span<const std::uint16_t> ring = scan.ring;
+  ws.recovered.reset();
+  if (lidar.model.vertical_angles_deg.empty() && config.recover_rows && !scan.has_ring()) {
+    StageTimer timer(seconds, Stage::kRangeImage);
+    ws.recovered = recover_rows(scan.points, config.row_recovery);
+    if (ws.recovered) {
+      ws.recovered->model.max_range = lidar.model.max_range;
+      model = &ws.recovered->model;
+      ring = ws.recovered->ring;
+    }
+  }
+  out.rows = static_cast<int>(model->rings());
+  out.row_source = ws.recovered ? RowSource::kRecovered : model->rings() > 0 ? RowSource::kModel : RowSource::kVoxelFallback;
+  if (model->vertical_angles_deg.empty()) {
     std::vector<std::uint32_t> kept;
     {
       StageTimer timer(seconds, Stage::kFeatures);
@@ -92,16 +118,17 @@ void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& l
     StageTimer timer(seconds, Stage::kDeskew);
     out.edges.clear();
     out.edge_times.clear();
+    out.voxel_samples = kept.size();
     deskew_selection(scan, times, kept, lidar, velocity, out.planes, out.plane_times);
     return;
   }
   {
     StageTimer timer(seconds, Stage::kRangeImage);
-    build_range_image(scan.points, scan.ring, lidar.model, ws.image);
+    build_range_image(scan.points, ring, *model, ws.image);
   }
   {
     StageTimer timer(seconds, Stage::kSegmentation);
-    ws.sorted_angles_deg = lidar.model.vertical_angles_deg;
+    ws.sorted_angles_deg = model->vertical_angles_deg;
     std::sort(ws.sorted_angles_deg.begin(), ws.sorted_angles_deg.end());
     const Eigen::Vector3f up_lidar = (lidar.T_base_lidar.rotation().conjugate() * Vec3::UnitZ()).cast<float>();
     segment_range_image(ws.image, scan.points, ws.sorted_angles_deg, up_lidar, config.segmentation, ws.segmentation);
@@ -109,6 +136,16 @@ void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& l
   {
     StageTimer timer(seconds, Stage::kFeatures);
     extract_features(ws.image, ws.segmentation, config.features, ws.features, ws.indices);
+    if (out.row_source == RowSource::kRecovered) {
+      // The voxel samples too, so the map covers the scene as it does for the
+      // LiDAR's scans that show no rows (whose samples fit poorly against a
+      // map of range-image planes alone: BALM keyframes 0.15 m against 0.04 m).
+      const std::vector<std::uint32_t> samples = voxel_subsample(scan.points, config.fallback_voxel_m);
+      ws.indices.planes.insert(ws.indices.planes.end(), samples.begin(), samples.end());
+      out.voxel_samples = samples.size();
+    } else {
+      out.voxel_samples = 0;
+    }
   }
   StageTimer timer(seconds, Stage::kDeskew);
   deskew_selection(scan, times, ws.indices.edges, lidar, velocity, out.edges, out.edge_times);

@@ -1,9 +1,12 @@
 #pragma once
 // Per-LiDAR front end: range image -> segmentation -> features -> deskew into
 // the base frame at the frame stamp. A LiDAR without a vertical angle table
-// (a folder of plain clouds) falls back to a voxel subsample whose points all
-// serve as plane queries (the matcher checks planarity in the map).
+// (a folder of plain clouds) gets its rows recovered from each scan's
+// elevations (row_recovery.hpp); where a scan shows no rows (a solid-state
+// scanner) it falls back to a voxel subsample whose points all serve as
+// plane queries (the matcher checks planarity in the map).
 #include <array>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -12,6 +15,7 @@
 #include "mlidar/slam/deskew.hpp"
 #include "mlidar/slam/features.hpp"
 #include "mlidar/slam/range_image.hpp"
+#include "mlidar/slam/row_recovery.hpp"
 #include "mlidar/slam/segmentation.hpp"
 
 namespace mlidar::slam {
@@ -20,6 +24,10 @@ enum class Stage : std::uint8_t { kRangeImage, kSegmentation, kFeatures, kDeskew
 inline constexpr std::size_t kStageCount = 6;
 const char* stage_name(Stage stage);  ///< "range_image", ...
 
+/// Where a LiDAR's range-image rows came from in one frame.
+enum class RowSource : std::uint8_t { kModel, kRecovered, kVoxelFallback };
+const char* row_source_name(RowSource source);  ///< "model", "recovered", "voxel_fallback"
+
 /// Seconds spent per stage (summed over LiDARs when they run one after another).
 using StageSeconds = std::array<double, kStageCount>;
 
@@ -27,6 +35,9 @@ struct FrontEndConfig {
   SegmentationConfig segmentation;
   FeatureConfig features;
   double fallback_voxel_m = 0.5;  ///< subsample size for LiDARs without a model
+  /// For LiDARs without a model: recover each scan's rows (on) or always use the voxel fallback.
+  bool recover_rows = true;
+  RowRecoveryConfig row_recovery;
 };
 
 /// One LiDAR as the odometry sees it.
@@ -45,6 +56,13 @@ struct LidarFeatures {
   /// deskew the features again.
   std::vector<float> edge_times;
   std::vector<float> plane_times;
+  /// Rows of the range image the features came from: the model's rings, or
+  /// those recovered from the scan; 0 when the voxel fallback made them.
+  int rows = 0;
+  RowSource row_source = RowSource::kModel;
+  /// Of `planes`, how many are voxel samples rather than range-image planes
+  /// (all with the fallback; with recovered rows the samples come after the planes).
+  std::size_t voxel_samples = 0;
 };
 
 /// Buffers reused across frames (one per LiDAR, so LiDARs can run in parallel).
@@ -54,6 +72,7 @@ struct FrontEndWorkspace {
   FeatureWorkspace features;
   FeatureIndices indices;
   std::vector<double> sorted_angles_deg;
+  std::optional<RecoveredRows> recovered;
 };
 
 /// Runs the front end; `velocity` deskews each point to the base at

@@ -199,7 +199,7 @@ RegistrationConfig Odometry::frame_registration(const SE3& prediction, double th
   return config;
 }
 
-TrustRule Odometry::trust_rule() const { return {config_.trust, recent_residuals_.median_m()}; }
+TrustRule Odometry::trust_rule() const { return {config_.trust, residual_scale_ * recent_residuals_.median_m()}; }
 
 void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
   // Eq 4.12 again with the velocity from the previous centroid to this registration: the
@@ -227,7 +227,8 @@ void Odometry::add_retries(const SE3& prediction, double threshold, const Motion
                            std::vector<RegistrationResult>& out) const {
   std::vector<SE3> starts;
   const auto add_turned = [&](const SE3& around) {
-    for (const double yaw_deg : config_.retry_yaw_deg) starts.push_back(around * SE3(so3_exp(Vec3(0, 0, deg_to_rad(yaw_deg))), Vec3::Zero()));
+    for (const double yaw_deg : config_.retry_yaw_deg)
+      starts.push_back(around * SE3(so3_exp(Vec3(0, 0, deg_to_rad(yaw_deg))), Vec3::Zero()));
   };
   add_turned(prediction);
   if (config_.retry_from_previous_pose) {
@@ -292,14 +293,21 @@ FrameResult Odometry::process(const Frame& frame) {
     run_front_end(frame.scans[i], centroid_stamp, lidars_[i], velocity, config_.front_end, workspaces_[i], features_[i], per_lidar[i]);
   });
   clear_features(frame_features_);
+  std::size_t voxel_features = 0;
   for (std::size_t i = 0; i < lidars_.size(); ++i) {
+    voxel_features += features_[i].voxel_samples;
     for (std::size_t s = 0; s < kStageCount; ++s) result.seconds[s] += per_lidar[i][s];
     result.points_in += frame.scans[i].size();
     result.lidar_features.push_back(features_[i].edges.size() + features_[i].planes.size());
+    result.lidar_rows.push_back(features_[i].rows);
+    result.lidar_row_source.push_back(features_[i].row_source);
     append_features(features_[i], frame_features_);
   }
   result.edge_features = frame_features_.edges.size();
   result.plane_features = frame_features_.planes.size();
+  const std::size_t all_features = result.edge_features + result.plane_features;
+  residual_scale_ = 1.0 + (config_.trust.voxel_residual_ratio - 1.0) *
+                              (all_features > 0 ? static_cast<double>(voxel_features) / static_cast<double>(all_features) : 0.0);
 
   auto start = std::chrono::steady_clock::now();
   SE3 T_world_centroid = SE3::identity();
@@ -341,7 +349,7 @@ FrameResult Odometry::process(const Frame& frame) {
   }
   // Every registered frame, suspect ones too: a lasting change of the fit (a rougher scene) moves the
   // median within half the history instead of leaving every later frame suspect and the map frozen.
-  if (centroid_poses_.size() >= 2 && !result.lost()) recent_residuals_.add(result.registration.mean_residual_m);
+  if (centroid_poses_.size() >= 2 && !result.lost()) recent_residuals_.add(result.registration.mean_residual_m / residual_scale_);
   result.seconds[static_cast<std::size_t>(Stage::kMapUpdate)] += seconds_since(start);
   result.T_world_base = centroid_poses_.back().T_world_base * latest_velocity().pose_at(-result.centroid_time);
   return result;

@@ -112,6 +112,9 @@ struct FrameResult {
   /// (RegistrationResult::selection) how many of them the registration chose.
   std::vector<std::size_t> lidar_features;
   std::vector<std::size_t> lidar_selected;
+  /// Per LiDAR (construction order): its range image's rows (0: voxel fallback) and where they came from.
+  std::vector<int> lidar_rows;
+  std::vector<RowSource> lidar_row_source;
   /// With adaptive feature selection: the full set's degeneracy factors where
   /// this frame evaluated them, and whether the scene counts as degenerate (sec 5.4.4).
   std::optional<Degeneracy> full_set_degeneracy;
@@ -169,7 +172,10 @@ class Odometry {
   VoxelMap edge_map_;
   VoxelMap plane_map_;
   std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid
-  ResidualHistory recent_residuals_;  ///< mean |r| of the last registered (not lost) frames
+  /// Mean |r| of the last registered (not lost) frames, each divided by its
+  /// frame's residual_scale_ (TrustConfig::voxel_residual_ratio).
+  ResidualHistory recent_residuals_;
+  double residual_scale_ = 1.0;  ///< this frame's
   RegistrationConfig registration_;  ///< this frame's (frame_registration)
   double degeneracy_stamp_ = -std::numeric_limits<double>::infinity();  ///< when lambda was last evaluated
   bool degenerate_scene_ = false;

@@ -25,6 +25,12 @@ struct TrustConfig {
   double residual_ratio = 2.0;            ///< trusted: mean |r| at most this x the recent median ...
   double residual_floor_m = 0.03;         ///< ... or at most this, whichever is larger
   std::size_t residual_history = 10;      ///< registered frames the recent median is taken over
+  /// Voxel samples (the front end's fallback) fit this much looser than
+  /// range-image features of the same scene (real BALM keyframes: 0.04-0.06 m
+  /// against 0.017-0.022 m): a frame's mean |r| is compared with the recent
+  /// ones scaled by 1 + (ratio - 1) x its share of voxel samples, so a run
+  /// whose front end changes between frames judges each by its kind.
+  double voxel_residual_ratio = 1.3;
   double ambiguity_ratio = 1.15;          ///< a rival within this x the best's mean |r| ...
   double distinct_translation_m = 0.2;    ///< ... farther than this ...
   double distinct_rotation_deg = 2.0;     ///< ... or turned more than this makes the best ambiguous

@@ -1,0 +1,310 @@
+#include "mlidar/slam/row_recovery.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "mlidar/core/median.hpp"
+#include "mlidar/slam/range_image.hpp"
+
+namespace mlidar::slam {
+namespace {
+
+constexpr double kDegrees = 180.0 / std::numbers::pi;
+
+/// The points rows are recovered from: finite, beyond the minimum range.
+struct UsablePoints {
+  std::vector<std::uint32_t> index;  ///< into the input
+  std::vector<float> rho, z;         ///< horizontal distance and height
+  std::vector<float> azimuth_deg;    ///< in [0, 360)
+  std::vector<std::uint16_t> sector;
+};
+
+UsablePoints usable_points(std::span<const Eigen::Vector3f> points, const RowRecoveryConfig& config) {
+  UsablePoints usable;
+  const int sectors = std::max(1, static_cast<int>(std::lround(360.0 / config.sector_deg)));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite() || p.norm() < config.min_range_m) continue;
+    double azimuth = fast_atan2(p.y(), p.x()) * kDegrees;
+    if (azimuth < 0.0) azimuth += 360.0;
+    usable.index.push_back(static_cast<std::uint32_t>(i));
+    usable.rho.push_back(std::hypot(p.x(), p.y()));
+    usable.z.push_back(p.z());
+    usable.azimuth_deg.push_back(static_cast<float>(azimuth));
+    usable.sector.push_back(static_cast<std::uint16_t>(std::min(sectors - 1, static_cast<int>(azimuth / 360.0 * sectors))));
+  }
+  return usable;
+}
+
+/// Elevation histograms over [-90, 90] deg.
+class Histograms {
+ public:
+  Histograms(double bin_deg, int sectors) : bin_deg_(bin_deg), bins_(static_cast<int>(std::ceil(180.0 / bin_deg)) + 1), sectors_(sectors) {}
+  int bins() const { return bins_; }
+  int bin(double elevation_deg) const { return std::clamp(static_cast<int>(std::floor((elevation_deg + 90.0) / bin_deg_)), 0, bins_ - 1); }
+  double centre_deg(double bin) const { return (bin + 0.5) * bin_deg_ - 90.0; }
+  int sectors() const { return sectors_; }
+
+ private:
+  double bin_deg_;
+  int bins_;
+  int sectors_;
+};
+
+/// Two passes of [1 2 1] / 4.
+std::vector<double> smoothed(std::vector<double> counts) {
+  std::vector<double> next(counts.size(), 0.0);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t j = 0; j < counts.size(); ++j) {
+      const double left = j > 0 ? counts[j - 1] : 0.0;
+      const double right = j + 1 < counts.size() ? counts[j + 1] : 0.0;
+      next[j] = 0.25 * left + 0.5 * counts[j] + 0.25 * right;
+    }
+    counts.swap(next);
+  }
+  return counts;
+}
+
+/// Per sector, the bin shift that maps its beams onto those of the sectors
+/// before it: each sector's smoothed histogram cross-correlated with the sum
+/// of the last few sectors' corrected ones (a template, so steps smaller than
+/// a bin do not round away as they would between neighbours), within
+/// +-max_step bins of the previous sector's shift; re-centred on zero.
+std::vector<int> sector_shifts(const std::vector<int>& bins, const UsablePoints& usable, const Histograms& h, int max_step) {
+  constexpr std::size_t kTemplateSectors = 6;
+  const auto sectors = static_cast<std::size_t>(h.sectors());
+  const auto bin_count = static_cast<std::size_t>(h.bins());
+  std::vector<std::vector<double>> histogram(sectors, std::vector<double>(bin_count, 0.0));
+  std::vector<int> lo(sectors, h.bins()), hi(sectors, -1);
+  for (std::size_t k = 0; k < bins.size(); ++k) {
+    const std::size_t s = usable.sector[k];
+    histogram[s][static_cast<std::size_t>(bins[k])] += 1.0;
+    lo[s] = std::min(lo[s], bins[k]);
+    hi[s] = std::max(hi[s], bins[k]);
+  }
+  for (auto& counts : histogram) counts = smoothed(std::move(counts));
+  // The template: the last kTemplateSectors non-empty sectors' histograms, in corrected bins.
+  std::vector<double> templ(bin_count, 0.0);
+  const auto add_to_template = [&](std::size_t sector, double sign, int offset) {
+    for (int bin = std::max(0, lo[sector] - 2); bin <= std::min(h.bins() - 1, hi[sector] + 2); ++bin) {  // smoothing spreads 2 bins
+      const int corrected = bin - offset;
+      if (corrected >= 0 && corrected < h.bins())
+        templ[static_cast<std::size_t>(corrected)] += sign * histogram[sector][static_cast<std::size_t>(bin)];
+    }
+  };
+  std::vector<int> shift(sectors, 0);
+  std::vector<std::size_t> matched;  // non-empty sectors so far
+  int current = 0;
+  for (std::size_t s = 0; s < sectors; ++s) {
+    if (hi[s] >= 0 && !matched.empty()) {
+      double best = -1.0;
+      int best_shift = current;
+      for (int candidate = current - max_step; candidate <= current + max_step; ++candidate) {
+        double score = 0.0;
+        for (int a = std::max(0, lo[s] - 2); a <= std::min(h.bins() - 1, hi[s] + 2); ++a) {
+          const int corrected = a - candidate;
+          if (corrected >= 0 && corrected < h.bins())
+            score += histogram[s][static_cast<std::size_t>(a)] * templ[static_cast<std::size_t>(corrected)];
+        }
+        // Ties go to the smaller step.
+        if (score > best + 1e-9 || (std::abs(score - best) <= 1e-9 && std::abs(candidate - current) < std::abs(best_shift - current))) {
+          best = score;
+          best_shift = candidate;
+        }
+      }
+      current = best_shift;
+    }
+    shift[s] = current;
+    if (hi[s] < 0) continue;
+    matched.push_back(s);
+    add_to_template(s, 1.0, current);
+    if (matched.size() > kTemplateSectors) {
+      const std::size_t leaving = matched[matched.size() - 1 - kTemplateSectors];
+      add_to_template(leaving, -1.0, shift[leaving]);
+    }
+  }
+  long sum = 0;
+  for (const int value : shift) sum += value;
+  const int mean = static_cast<int>(std::lround(static_cast<double>(sum) / static_cast<double>(sectors)));
+  for (int& value : shift) value -= mean;
+  return shift;
+}
+
+std::vector<int> elevation_bins(const UsablePoints& usable, double origin_z, const Histograms& h) {
+  std::vector<int> bins(usable.index.size());
+  for (std::size_t k = 0; k < bins.size(); ++k) bins[k] = h.bin(fast_atan2(usable.z[k] - origin_z, usable.rho[k]) * kDegrees);
+  return bins;
+}
+
+std::vector<double> corrected_counts(const std::vector<int>& bins, const std::vector<int>& shift, const UsablePoints& usable,
+                                     const Histograms& h) {
+  std::vector<double> counts(static_cast<std::size_t>(h.bins()), 0.0);
+  for (std::size_t k = 0; k < bins.size(); ++k)
+    counts[static_cast<std::size_t>(std::clamp(bins[k] - shift[usable.sector[k]], 0, h.bins() - 1))] += 1.0;
+  return counts;
+}
+
+double sharpness(const std::vector<double>& counts) {
+  double squares = 0.0, total = 0.0;
+  for (const double c : counts) {
+    squares += c * c;
+    total += c;
+  }
+  return total > 0.0 ? squares / total : 0.0;
+}
+
+/// Peaks of the smoothed histogram, those with a shallow valley between them merged.
+std::vector<int> histogram_peaks(const std::vector<double>& s, double merge_valley_ratio) {
+  std::vector<int> peaks;
+  for (int j = 0; j < static_cast<int>(s.size()); ++j) {
+    const auto u = static_cast<std::size_t>(j);
+    const double left = j > 0 ? s[u - 1] : 0.0;
+    const double right = u + 1 < s.size() ? s[u + 1] : 0.0;
+    if (s[u] > 0.0 && s[u] >= left && s[u] > right) peaks.push_back(j);
+  }
+  const auto valley = [&s](int a, int b) { return *std::min_element(s.begin() + a, s.begin() + b + 1); };
+  for (bool merged = true; merged && peaks.size() > 1;) {
+    merged = false;
+    for (std::size_t k = 0; k + 1 < peaks.size(); ++k) {
+      const double low = std::min(s[static_cast<std::size_t>(peaks[k])], s[static_cast<std::size_t>(peaks[k + 1])]);
+      if (valley(peaks[k], peaks[k + 1]) > merge_valley_ratio * low) {
+        const bool keep_first = s[static_cast<std::size_t>(peaks[k])] >= s[static_cast<std::size_t>(peaks[k + 1])];
+        peaks.erase(peaks.begin() + static_cast<std::ptrdiff_t>(keep_first ? k + 1 : k));
+        merged = true;
+        break;
+      }
+    }
+  }
+  return peaks;
+}
+
+/// Row intervals [lower[r], lower[r + 1]) in corrected bins: valleys between peaks, half a spacing beyond the outer ones.
+std::vector<int> row_bounds(const std::vector<double>& s, const std::vector<int>& peaks) {
+  std::vector<int> bounds;
+  bounds.push_back(peaks.front() - (peaks[1] - peaks[0]) / 2);
+  for (std::size_t k = 0; k + 1 < peaks.size(); ++k)
+    bounds.push_back(static_cast<int>(std::min_element(s.begin() + peaks[k], s.begin() + peaks[k + 1] + 1) - s.begin()));
+  bounds.push_back(peaks.back() + (peaks.back() - peaks[peaks.size() - 2]) / 2 + 1);
+  return bounds;
+}
+
+/// Median azimuth step between neighbouring points of a row, over the rows.
+double azimuth_resolution_deg(const std::vector<std::vector<float>>& row_azimuths) {
+  std::vector<double> steps;
+  for (std::vector<float> azimuths : row_azimuths) {
+    if (azimuths.size() < 16) continue;
+    std::sort(azimuths.begin(), azimuths.end());
+    std::vector<double> gaps;
+    for (std::size_t k = 1; k < azimuths.size(); ++k)
+      if (azimuths[k] - azimuths[k - 1] > 1e-3F) gaps.push_back(azimuths[k] - azimuths[k - 1]);
+    if (!gaps.empty()) steps.push_back(median(std::move(gaps)));
+  }
+  return steps.empty() ? 0.0 : median(std::move(steps));
+}
+
+}  // namespace
+
+std::optional<RecoveredRows> recover_rows(std::span<const Eigen::Vector3f> points, const RowRecoveryConfig& config) {
+  const UsablePoints usable = usable_points(points, config);
+  if (usable.index.size() < static_cast<std::size_t>(16 * config.min_rows)) return std::nullopt;
+  const Histograms h(config.bin_deg, std::max(1, static_cast<int>(std::lround(360.0 / config.sector_deg))));
+  const int max_step = std::max(1, static_cast<int>(std::lround(config.max_step_deg / config.bin_deg)));
+
+  // z0 is searched on at most kSearchPoints of the points (every stride-th), then the shifts found on all of them.
+  constexpr std::size_t kSearchPoints = 16000;
+  const std::size_t stride = std::max<std::size_t>(1, usable.index.size() / kSearchPoints);
+  UsablePoints search;
+  for (std::size_t k = 0; k < usable.index.size(); k += stride) {
+    search.rho.push_back(usable.rho[k]);
+    search.z.push_back(usable.z[k]);
+    search.sector.push_back(usable.sector[k]);
+  }
+  search.index.resize(search.rho.size());
+  double best_sharpness = -1.0, origin_z = 0.0;
+  const auto try_origin = [&](double z0) {
+    const std::vector<int> candidate_bins = elevation_bins(search, z0, h);
+    const double value = sharpness(corrected_counts(candidate_bins, sector_shifts(candidate_bins, search, h, max_step), search, h));
+    if (value > best_sharpness + 1e-12) {
+      best_sharpness = value;
+      origin_z = z0;
+    }
+  };
+  // Every second step of the grid, then the two beside the best.
+  const int steps = static_cast<int>(std::lround(config.origin_z_range_m / config.origin_z_step_m));
+  for (int step = -steps; step <= steps; step += 2) try_origin(step * config.origin_z_step_m);
+  const double coarse = origin_z;
+  for (const double side : {-1.0, 1.0})
+    if (std::abs(coarse + side * config.origin_z_step_m) <= config.origin_z_range_m + 1e-12)
+      try_origin(coarse + side * config.origin_z_step_m);
+  const std::vector<int> bins = elevation_bins(usable, origin_z, h);
+  const std::vector<int> shift = sector_shifts(bins, usable, h, max_step);
+
+  const std::vector<double> s = smoothed(corrected_counts(bins, shift, usable, h));
+  const std::vector<int> peaks = histogram_peaks(s, config.merge_valley_ratio);
+  if (peaks.size() < static_cast<std::size_t>(std::max(2, config.min_rows))) return std::nullopt;
+  const std::vector<int> bounds = row_bounds(s, peaks);
+  const std::size_t rows = peaks.size();
+
+  std::vector<int> point_row(usable.index.size(), -1);
+  std::vector<std::vector<double>> row_elevations(rows);
+  for (std::size_t k = 0; k < point_row.size(); ++k) {
+    const int corrected = bins[k] - shift[usable.sector[k]];
+    if (corrected < bounds.front() || corrected >= bounds.back()) continue;
+    const auto row = static_cast<std::size_t>(std::upper_bound(bounds.begin(), bounds.end(), corrected) - bounds.begin() - 1);
+    point_row[k] = static_cast<int>(row);
+    row_elevations[row].push_back(h.centre_deg(corrected));
+  }
+
+  // Rows holding a tenth of the median row's points or less are noise between beams.
+  std::vector<double> sizes;
+  for (const auto& e : row_elevations) sizes.push_back(static_cast<double>(e.size()));
+  const double min_points = 0.1 * median(sizes);
+  std::vector<int> renumber(rows, -1);
+  RecoveredRows result;
+  std::vector<double> kept_centres, kept_spread;
+  for (std::size_t r = 0; r < rows; ++r) {
+    if (static_cast<double>(row_elevations[r].size()) <= min_points) continue;
+    renumber[r] = static_cast<int>(kept_centres.size());
+    const double centre = median(row_elevations[r]);
+    double sq = 0.0;
+    for (const double e : row_elevations[r]) sq += (e - centre) * (e - centre);
+    kept_centres.push_back(centre);
+    kept_spread.push_back(std::sqrt(sq / static_cast<double>(row_elevations[r].size())));
+  }
+  if (kept_centres.size() < static_cast<std::size_t>(config.min_rows)) return std::nullopt;
+
+  std::vector<double> ratios;
+  for (std::size_t r = 0; r < kept_centres.size(); ++r) {
+    double spacing = std::numeric_limits<double>::infinity();
+    if (r > 0) spacing = std::min(spacing, kept_centres[r] - kept_centres[r - 1]);
+    if (r + 1 < kept_centres.size()) spacing = std::min(spacing, kept_centres[r + 1] - kept_centres[r]);
+    ratios.push_back(kept_spread[r] / std::max(spacing, config.bin_deg));
+  }
+  result.width_ratio = median(ratios);
+
+  result.ring.assign(points.size(), kNoRow);
+  std::vector<std::vector<float>> row_azimuths(kept_centres.size());
+  std::size_t assigned = 0;
+  for (std::size_t k = 0; k < point_row.size(); ++k) {
+    if (point_row[k] < 0 || renumber[static_cast<std::size_t>(point_row[k])] < 0) continue;
+    const int row = renumber[static_cast<std::size_t>(point_row[k])];
+    result.ring[usable.index[k]] = static_cast<std::uint16_t>(row);
+    row_azimuths[static_cast<std::size_t>(row)].push_back(usable.azimuth_deg[k]);
+    ++assigned;
+  }
+  result.assigned_share = static_cast<double>(assigned) / static_cast<double>(usable.index.size());
+  result.origin_z_m = origin_z;
+  if (result.width_ratio > config.max_width_ratio || result.assigned_share < config.min_assigned_share) return std::nullopt;
+
+  result.model.name = "recovered-" + std::to_string(kept_centres.size());
+  result.model.vertical_angles_deg = kept_centres;
+  result.model.horizontal_resolution_deg = azimuth_resolution_deg(row_azimuths);
+  result.model.min_range = config.min_range_m;
+  if (!(result.model.horizontal_resolution_deg > 0.0)) return std::nullopt;
+  return result;
+}
+
+}  // namespace mlidar::slam
