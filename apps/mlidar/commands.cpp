@@ -45,8 +45,8 @@ std::string suspect_frames_warning(const std::vector<std::size_t>& frames) {
   text << "warning: " << frames.size() << (frames.size() == 1 ? " frame suspect (frame " : " frames suspect (frames ");
   for (std::size_t i = 0; i < frames.size() && i < 10; ++i) text << (i > 0 ? ", " : "") << frames[i];
   if (frames.size() > 10) text << " and " << frames.size() - 10 << " more";
-  text << ", from 0): the best registration fits clearly worse than the frames before, or another alignment fits as well; "
-          "the pose may be wrong and the frame was kept out of the map (metrics.json per_frame trust)\n";
+  text << ", from 0): the best registration fits clearly worse than the frames before, another alignment fits as well, or "
+          "it is degenerate and moved far from the motion prior; the pose may be wrong and the frame was kept out of the map (metrics.json per_frame trust)\n";
   return text.str();
 }
 

@@ -21,9 +21,7 @@ slam::RegistrationResult candidate(double mean_residual_m, double match_ratio, c
   return r;
 }
 
-SE3 moved(double x_m, double yaw_deg = 0.0) {
-  return SE3(so3_exp(Vec3(0, 0, yaw_deg * std::numbers::pi / 180.0)), Vec3(x_m, 0, 0));
-}
+SE3 moved(double x_m, double yaw_deg = 0.0) { return SE3(so3_exp(Vec3(0, 0, yaw_deg * std::numbers::pi / 180.0)), Vec3(x_m, 0, 0)); }
 
 TEST(ResidualHistory, IsTheMedianOfTheLastOnes) {
   slam::ResidualHistory history(3);
@@ -87,6 +85,26 @@ TEST(ChooseRegistration, AnAlignmentElsewhereThatFitsAsWellMakesItAmbiguous) {
   // Clearly worse elsewhere (0.076 vs 0.051 m: BALM 110 -> 112): the best is unique.
   const std::vector<slam::RegistrationResult> clear = {candidate(0.076, 0.9, moved(2.1)), candidate(0.051, 0.9)};
   EXPECT_EQ(slam::choose_registration(clear, rule).trust, slam::Trust::kTrusted);
+}
+
+// A degenerate registration may hold the weak direction at its start but not
+// move far from the prediction on geometry that does not pin the move.
+TEST(JudgeDegenerateCorrection, ADegenerateRegistrationThatMovedFarIsSuspect) {
+  const slam::TrustConfig config;  // 0.3 m, 3 deg
+  const SE3 prediction = moved(1.0, 10.0);
+  slam::RegistrationResult r = candidate(0.03, 0.9, prediction * moved(0.5));
+  r.degenerate = true;
+  EXPECT_EQ(slam::judge_degenerate_correction(slam::Trust::kTrusted, r, prediction, config), slam::Trust::kDegenerate);
+  r.T_world_base = prediction * moved(0.0, 5.0);
+  EXPECT_EQ(slam::judge_degenerate_correction(slam::Trust::kTrusted, r, prediction, config), slam::Trust::kDegenerate);
+  r.T_world_base = prediction * moved(0.2, 2.0);  // within both bounds
+  EXPECT_EQ(slam::judge_degenerate_correction(slam::Trust::kTrusted, r, prediction, config), slam::Trust::kTrusted);
+  r.T_world_base = prediction * moved(0.5);
+  r.degenerate = false;  // well constrained: the correction is the geometry's
+  EXPECT_EQ(slam::judge_degenerate_correction(slam::Trust::kTrusted, r, prediction, config), slam::Trust::kTrusted);
+  r.degenerate = true;  // already judged: kept
+  EXPECT_EQ(slam::judge_degenerate_correction(slam::Trust::kAmbiguous, r, prediction, config), slam::Trust::kAmbiguous);
+  EXPECT_STREQ(slam::trust_name(slam::Trust::kDegenerate), "degenerate");
 }
 
 }  // namespace

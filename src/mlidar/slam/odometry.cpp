@@ -263,16 +263,20 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, double cen
   std::vector<RegistrationResult> candidates;
   candidates.push_back(register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold,
                                             registration_, motion));
-  if (rule.trusted(candidates.front())) {
-    frame.trust = Trust::kTrusted;
-    return std::move(candidates.front());
+  // After a long gap the constant-velocity prediction says little, and one
+  // alignment that fits is no evidence that it is the only one: the retries
+  // run and decide, rivals included.
+  const bool long_gap = centroid_stamp - centroid_poses_.back().stamp > config_.always_retry_after_s;
+  if (rule.trusted(candidates.front()) && !long_gap) {
+    frame.trust = judge_degenerate_correction(Trust::kTrusted, candidates.front(), prediction, config_.trust);
+    if (frame.trust == Trust::kTrusted) return std::move(candidates.front());
   }
   // Every retry runs (not only up to the first trusted one): the first to pass
   // may be a wrong alignment that a later start beats, and the rivals say whether the best is unique.
   frame.retried = true;
   add_retries(prediction, threshold, motion, candidates);
   const Choice choice = choose_registration(candidates, rule);
-  frame.trust = choice.trust;
+  frame.trust = judge_degenerate_correction(choice.trust, candidates[choice.best], prediction, config_.trust);
   return std::move(candidates[choice.best]);
 }
 

@@ -62,6 +62,9 @@ struct OdometryConfig {
   /// same yaws: after a second of handheld motion the constant-velocity
   /// prediction can be metres off.
   bool retry_from_previous_pose = true;
+  /// Frames this long after the previous one (seconds) always run the retries
+  /// and are judged with their rivals, trusted first registration or not.
+  double always_retry_after_s = 1.5;
   /// After a trusted registration, deskew the frame's features again with the
   /// velocity it measured (the prediction's is a frame late) and register once
   /// more from there, before they enter the map. Off: it costs a second
@@ -102,7 +105,7 @@ struct FrameResult {
   /// No acceptable registration: the pose is the prediction, not mapped.
   bool lost() const { return trust == Trust::kLost; }
   /// Acceptable but not trusted (`trust` says why): the pose is kept, not mapped.
-  bool suspect() const { return trust == Trust::kResidual || trust == Trust::kAmbiguous; }
+  bool suspect() const { return trust == Trust::kResidual || trust == Trust::kAmbiguous || trust == Trust::kDegenerate; }
   /// Lost or suspect: its pose must not feed a calibration, a window or a map.
   bool flagged() const { return lost() || suspect(); }
   /// Per LiDAR (construction order): mean |r| of its matched features at the

@@ -13,10 +13,16 @@ namespace mlidar::slam {
 
 const char* trust_name(Trust trust) {
   switch (trust) {
-    case Trust::kTrusted: return "trusted";
-    case Trust::kResidual: return "residual";
-    case Trust::kAmbiguous: return "ambiguous";
-    case Trust::kLost: return "lost";
+    case Trust::kTrusted:
+      return "trusted";
+    case Trust::kResidual:
+      return "residual";
+    case Trust::kAmbiguous:
+      return "ambiguous";
+    case Trust::kDegenerate:
+      return "degenerate";
+    case Trust::kLost:
+      return "lost";
   }
   return "?";
 }
@@ -74,6 +80,15 @@ Choice choose_registration(std::span<const RegistrationResult> candidates, const
     break;
   }
   return choice;
+}
+
+Trust judge_degenerate_correction(Trust trust, const RegistrationResult& r, const SE3& prediction, const TrustConfig& config) {
+  if (trust != Trust::kTrusted || !r.degenerate) return trust;
+  const SE3 correction = prediction.inverse() * r.T_world_base;
+  const double rotation_deg = so3_log(correction.rotation()).norm() * 180.0 / std::numbers::pi;
+  const bool far =
+      correction.translation().norm() > config.degenerate_max_correction_m || rotation_deg > config.degenerate_max_correction_deg;
+  return far ? Trust::kDegenerate : trust;
 }
 
 }  // namespace mlidar::slam

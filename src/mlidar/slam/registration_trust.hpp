@@ -20,27 +20,36 @@
 namespace mlidar::slam {
 
 struct TrustConfig {
-  double min_match_ratio = 0.5;           ///< acceptable: at least this share of features matched
-  double max_mean_residual_m = 0.2;       ///< acceptable: mean |r| at most this
-  double residual_ratio = 2.0;            ///< trusted: mean |r| at most this x the recent median ...
-  double residual_floor_m = 0.03;         ///< ... or at most this, whichever is larger
-  std::size_t residual_history = 10;      ///< registered frames the recent median is taken over
+  double min_match_ratio = 0.5;       ///< acceptable: at least this share of features matched
+  double max_mean_residual_m = 0.2;   ///< acceptable: mean |r| at most this
+  double residual_ratio = 2.0;        ///< trusted: mean |r| at most this x the recent median ...
+  double residual_floor_m = 0.03;     ///< ... or at most this, whichever is larger
+  std::size_t residual_history = 10;  ///< registered frames the recent median is taken over
   /// Voxel samples (the front end's fallback) fit this much looser than
   /// range-image features of the same scene (real BALM keyframes: 0.04-0.06 m
   /// against 0.017-0.022 m): a frame's mean |r| is compared with the recent
   /// ones scaled by 1 + (ratio - 1) x its share of voxel samples, so a run
   /// whose front end changes between frames judges each by its kind.
   double voxel_residual_ratio = 1.3;
-  double ambiguity_ratio = 1.15;          ///< a rival within this x the best's mean |r| ...
-  double distinct_translation_m = 0.2;    ///< ... farther than this ...
-  double distinct_rotation_deg = 2.0;     ///< ... or turned more than this makes the best ambiguous
+  double ambiguity_ratio = 1.15;        ///< a rival within this x the best's mean |r| ...
+  double distinct_translation_m = 0.2;  ///< ... farther than this ...
+  double distinct_rotation_deg = 2.0;   ///< ... or turned more than this makes the best ambiguous
+  /// A degenerate registration (translation observability below the
+  /// registration's degeneracy_threshold) that moved the pose farther than
+  /// this from its prediction is suspect: its geometry does not pin the
+  /// correction it made (simulated solid-state keyframes: the wrong ones slid
+  /// metres and tens of degrees along ground-dominated matches, at
+  /// observability 0.006-0.05 against 0.13-0.55 for right ones).
+  double degenerate_max_correction_m = 0.3;
+  double degenerate_max_correction_deg = 3.0;
 };
 
 enum class Trust {
-  kTrusted,    ///< fits like the recent frames; mapped
-  kResidual,   ///< suspect: fits clearly worse than the recent frames
-  kAmbiguous,  ///< suspect: another alignment elsewhere fits as well
-  kLost,       ///< not acceptable at all
+  kTrusted,     ///< fits like the recent frames; mapped
+  kResidual,    ///< suspect: fits clearly worse than the recent frames
+  kAmbiguous,   ///< suspect: another alignment elsewhere fits as well
+  kDegenerate,  ///< suspect: degenerate, and it moved far from the prediction
+  kLost,        ///< not acceptable at all
 };
 
 const char* trust_name(Trust trust);
@@ -77,5 +86,9 @@ struct Choice {
 /// Keeps the acceptable candidate with the smallest mean |r| (the first one
 /// when none is acceptable) and judges it. Candidates must not be empty.
 Choice choose_registration(std::span<const RegistrationResult> candidates, const TrustRule& rule);
+
+/// kDegenerate when `trust` is kTrusted but the registration is degenerate and
+/// moved farther from `prediction` than TrustConfig allows; `trust` otherwise.
+Trust judge_degenerate_correction(Trust trust, const RegistrationResult& r, const SE3& prediction, const TrustConfig& config);
 
 }  // namespace mlidar::slam
