@@ -57,9 +57,13 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
             << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost, " << summary.suspect_frames.size()
             << " suspect\n";
   for (const auto& line : summary.front_end) std::cout << "note: " << line << '\n';
-  if (summary.degenerate_frames > 0)
-    std::cerr << "warning: " << summary.degenerate_frames
-              << " frame(s) degenerate (translation weakly constrained, e.g. a corridor); see metrics.json\n";
+  if (summary.degenerate_frames > 0) {
+    std::cerr << "warning: " << summary.degenerate_frames << " frame(s) degenerate (translation weakly constrained, e.g. a corridor): ";
+    for (std::size_t i = 0; i < summary.degenerate_directions.size(); ++i)
+      std::cerr << (i > 0 ? ", " : "") << "along the base's " << summary.degenerate_directions[i].first << " in "
+                << summary.degenerate_directions[i].second;
+    std::cerr << "; that translation was held at the motion prior, not measured (metrics.json per_frame weak_direction)\n";
+  }
   std::cerr << suspect_frames_warning(summary.suspect_frames);
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";

@@ -51,6 +51,23 @@ TEST(RowRecovery, FindsEveryBeamOfARingLessScan) {
   }
 }
 
+// A ring channel in the sensor's firing order (interleaved, as Velodyne's) and
+// no model: rows by ascending elevation, angles measured from the points.
+TEST(RowRecovery, TakesRowsFromARingChannelInAnyOrder) {
+  const LidarModel model = test::uniform_model(16, -15.0, 15.0, 0.2);
+  test::CastScan cast = room_scan(model);
+  const auto interleaved = [](std::uint16_t beam) { return static_cast<std::uint16_t>(beam % 2 == 0 ? beam / 2 : 8 + beam / 2); };
+  std::vector<std::uint16_t> channel;
+  for (const std::uint16_t beam : cast.scan.ring) channel.push_back(interleaved(beam));
+  const auto rows = rows_from_ring_channel(cast.scan.points, channel);
+  ASSERT_TRUE(rows.has_value());
+  ASSERT_EQ(rows->model.rings(), 16U);
+  for (std::size_t r = 0; r < 16; ++r) EXPECT_NEAR(rows->model.vertical_angles_deg[r], model.vertical_angles_deg[r], 1e-4);
+  EXPECT_EQ(rows->ring, cast.scan.ring);  // beams of the uniform model ascend already
+  EXPECT_NEAR(rows->model.horizontal_resolution_deg, 0.2, 0.01);
+  EXPECT_FALSE(rows_from_ring_channel(cast.scan.points, std::vector<std::uint16_t>(cast.scan.size(), 0)).has_value()) << "one ring";
+}
+
 // Deskewed to one instant, a sweep during which the sensor tilted by 2 deg
 // has each beam's elevation drift with azimuth (and jump at the seam).
 TEST(RowRecovery, FollowsBeamsThatDriftWithAzimuth) {

@@ -16,6 +16,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mlidar/core/types.hpp"
@@ -42,6 +43,8 @@ struct OdometryJob {
 struct OdometryJobSummary {
   std::size_t frames = 0;
   std::size_t degenerate_frames = 0;
+  /// Of those, how many had their weak translation closest to each base axis (base_axis_words), most first.
+  std::vector<std::pair<std::string, std::size_t>> degenerate_directions;
   std::size_t lost_frames = 0;
   std::vector<std::size_t> suspect_frames;  ///< frame indices whose pose is doubtful (FrameResult::suspect)
   double mean_frame_seconds = 0.0;

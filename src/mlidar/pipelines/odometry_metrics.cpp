@@ -47,23 +47,43 @@ nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summa
 
 namespace {
 
-/// Per LiDAR: in how many frames its rows came from the model, were recovered (and how many), or the voxel fallback ran.
-nlohmann::json front_end_summary(const std::vector<std::string>& names, std::size_t frames,
-                                 const std::vector<std::vector<int>>& recovered_rows, const std::vector<std::size_t>& fallback_frames) {
+/// Per LiDAR: in how many frames its rows came from each source, and the rows recovered from the scans.
+nlohmann::json front_end_summary(const std::vector<std::string>& names, const std::vector<slam::FrameResult>& frames) {
   nlohmann::json summary = nlohmann::json::object();
   for (std::size_t i = 0; i < names.size(); ++i) {
-    std::vector<int> rows = recovered_rows[i];
+    nlohmann::json by_source = nlohmann::json::object();
+    for (const auto source :
+         {slam::RowSource::kModel, slam::RowSource::kRingChannel, slam::RowSource::kRecovered, slam::RowSource::kVoxelFallback})
+      by_source[slam::row_source_name(source)] = 0;
+    std::vector<int> rows;
+    for (const slam::FrameResult& f : frames) {
+      if (i >= f.lidar_row_source.size()) continue;
+      const std::string name = slam::row_source_name(f.lidar_row_source[i]);
+      by_source[name] = by_source[name].get<int>() + 1;
+      if (f.lidar_row_source[i] == slam::RowSource::kRecovered) rows.push_back(f.lidar_rows[i]);
+    }
     std::sort(rows.begin(), rows.end());
-    nlohmann::json recovered = {{"frames", rows.size()}};
-    if (!rows.empty()) recovered.update({{"rows_min", rows.front()}, {"rows_median", rows[rows.size() / 2]}, {"rows_max", rows.back()}});
-    summary[names[i]] = {{"model_frames", frames - rows.size() - fallback_frames[i]},
-                         {"recovered", recovered},
-                         {"voxel_fallback_frames", fallback_frames[i]}};
+    nlohmann::json recovered_rows = nullptr;
+    if (!rows.empty()) recovered_rows = {{"min", rows.front()}, {"median", rows[rows.size() / 2]}, {"max", rows.back()}};
+    summary[names[i]] = {{"frames_by_source", by_source}, {"recovered_rows", recovered_rows}};
   }
   return summary;
 }
 
 }  // namespace
+
+std::string base_axis_words(const Vec3& direction_base) {
+  Eigen::Index axis = 0;
+  direction_base.cwiseAbs().maxCoeff(&axis);
+  static constexpr const char* kWords[] = {"x (forward-backward)", "y (left-right)", "z (up-down)"};
+  return kWords[axis];
+}
+
+Vec3 weak_translation_base(const slam::FrameResult& frame) {
+  const slam::RegistrationResult& r = frame.registration;
+  if (!r.degenerate) return Vec3::Zero();
+  return r.T_world_base.rotation().conjugate() * r.weak_translation;
+}
 
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars) {
   nlohmann::json json;
@@ -79,14 +99,18 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
     json["stages"][slam::stage_name(static_cast<slam::Stage>(s))] = timing_summary(stage);
   }
   nlohmann::json per_frame = nlohmann::json::array();
-  std::vector<std::vector<int>> recovered_rows(names.size());
-  std::vector<std::size_t> fallback_frames(names.size(), 0);
+  nlohmann::json degenerate_directions = nlohmann::json::object();
   for (const auto& f : frames) {
+    nlohmann::json weak = nullptr, weak_words = nullptr;
+    if (f.registration.degenerate) {
+      const Vec3 direction = weak_translation_base(f);
+      weak = {direction.x(), direction.y(), direction.z()};
+      weak_words = base_axis_words(direction);
+      degenerate_directions[weak_words.get<std::string>()] = degenerate_directions.value(weak_words.get<std::string>(), 0) + 1;
+    }
     nlohmann::json front_end;
     for (std::size_t i = 0; i < names.size() && i < f.lidar_rows.size(); ++i) {
       front_end[names[i]] = {{"rows", f.lidar_rows[i]}, {"source", slam::row_source_name(f.lidar_row_source[i])}};
-      if (f.lidar_row_source[i] == slam::RowSource::kRecovered) recovered_rows[i].push_back(f.lidar_rows[i]);
-      fallback_frames[i] += f.lidar_row_source[i] == slam::RowSource::kVoxelFallback ? 1 : 0;
     }
     double sum = 0.0;
     for (const double v : f.seconds) sum += v;
@@ -102,6 +126,8 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
                          {"eigenvalues", std::vector<double>(r.eigenvalues.data(), r.eigenvalues.data() + 6)},
                          {"translation_observability", r.translation_observability},
                          {"degenerate", r.degenerate},
+                         {"weak_translation_base", weak},
+                         {"weak_direction", weak_words},
                          {"lost", f.lost()},
                          {"suspect", f.suspect()},
                          {"trust", slam::trust_name(f.trust)},
@@ -121,10 +147,11 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["points_in"] = timing_summary(points_in);
   json["features_out"] = timing_summary(features_out);
   json["degenerate_frames"] = degenerate;
+  json["degenerate_directions"] = degenerate_directions;
   json["retried_frames"] = retried;
   json["lost_frames"] = lost;
   json["suspect_frames"] = suspect;
-  json["front_end"] = front_end_summary(names, frames.size(), recovered_rows, fallback_frames);
+  json["front_end"] = front_end_summary(names, frames);
   json["per_frame"] = std::move(per_frame);
   return json;
 }

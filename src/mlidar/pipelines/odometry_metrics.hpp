@@ -21,6 +21,13 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
 /// (shared with slam's metrics.json; `selected` is the sum over the LiDARs: the fallback's all).
 nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summary, const std::vector<std::string>& lidar_names);
 
+/// The base axis a unit direction lies closest to, in words: "x (forward-backward)",
+/// "y (left-right)" or "z (up-down)" (a degenerate registration's weak translation).
+std::string base_axis_words(const Vec3& direction_base);
+
+/// A degenerate frame's weak translation in the base frame (zero when the frame is not degenerate).
+Vec3 weak_translation_base(const slam::FrameResult& frame);
+
 /// {mean, p50, p95, max} of `values` (zeros when empty).
 nlohmann::json timing_summary(std::vector<double> values);
 

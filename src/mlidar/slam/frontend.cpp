@@ -69,6 +69,8 @@ const char* row_source_name(RowSource source) {
   switch (source) {
     case RowSource::kModel:
       return "model";
+    case RowSource::kRingChannel:
+      return "ring_channel";
     case RowSource::kRecovered:
       return "recovered";
     case RowSource::kVoxelFallback:
@@ -98,9 +100,16 @@ void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& l
   const LidarModel* model = &lidar.model;
   std::span<const std::uint16_t> ring = scan.ring;
   ws.recovered.reset();
-  if (lidar.model.vertical_angles_deg.empty() && config.recover_rows && !scan.has_ring()) {
+  RowSource source = lidar.model.vertical_angles_deg.empty() ? RowSource::kVoxelFallback : RowSource::kModel;
+  if (source == RowSource::kVoxelFallback && config.recover_rows) {
     StageTimer timer(seconds, Stage::kRangeImage);
-    ws.recovered = recover_rows(scan.points, config.row_recovery);
+    if (scan.has_ring()) {
+      ws.recovered = rows_from_ring_channel(scan.points, scan.ring, config.row_recovery);
+      if (ws.recovered) source = RowSource::kRingChannel;
+    } else {
+      ws.recovered = recover_rows(scan.points, config.row_recovery);
+      if (ws.recovered) source = RowSource::kRecovered;
+    }
     if (ws.recovered) {
       ws.recovered->model.max_range = lidar.model.max_range;
       model = &ws.recovered->model;
@@ -108,7 +117,7 @@ void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& l
     }
   }
   out.rows = static_cast<int>(model->rings());
-  out.row_source = ws.recovered ? RowSource::kRecovered : model->rings() > 0 ? RowSource::kModel : RowSource::kVoxelFallback;
+  out.row_source = source;
   if (model->vertical_angles_deg.empty()) {
     std::vector<std::uint32_t> kept;
     {

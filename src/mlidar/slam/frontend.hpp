@@ -1,8 +1,9 @@
 #pragma once
 // Per-LiDAR front end: range image -> segmentation -> features -> deskew into
 // the base frame at the frame stamp. A LiDAR without a vertical angle table
-// (a folder of plain clouds) gets its rows recovered from each scan's
-// elevations (row_recovery.hpp); where a scan shows no rows (a solid-state
+// (a folder of plain clouds) takes its rows from the scan's `ring` channel
+// (angles from the points), or recovers them from the scan's elevations
+// (row_recovery.hpp); where a scan shows no rows (a solid-state
 // scanner) it falls back to a voxel subsample whose points all serve as
 // plane queries (the matcher checks planarity in the map).
 #include <array>
@@ -25,8 +26,8 @@ inline constexpr std::size_t kStageCount = 6;
 const char* stage_name(Stage stage);  ///< "range_image", ...
 
 /// Where a LiDAR's range-image rows came from in one frame.
-enum class RowSource : std::uint8_t { kModel, kRecovered, kVoxelFallback };
-const char* row_source_name(RowSource source);  ///< "model", "recovered", "voxel_fallback"
+enum class RowSource : std::uint8_t { kModel, kRingChannel, kRecovered, kVoxelFallback };
+const char* row_source_name(RowSource source);  ///< "model", "ring_channel", "recovered", "voxel_fallback"
 
 /// Seconds spent per stage (summed over LiDARs when they run one after another).
 using StageSeconds = std::array<double, kStageCount>;

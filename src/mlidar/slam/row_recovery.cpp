@@ -307,4 +307,48 @@ std::optional<RecoveredRows> recover_rows(std::span<const Eigen::Vector3f> point
   return result;
 }
 
+std::optional<RecoveredRows> rows_from_ring_channel(std::span<const Eigen::Vector3f> points, std::span<const std::uint16_t> ring,
+                                                    const RowRecoveryConfig& config) {
+  if (ring.size() != points.size()) return std::nullopt;
+  std::vector<std::vector<double>> elevations;
+  std::vector<std::vector<float>> azimuths;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite() || p.norm() < config.min_range_m || ring[i] == kNoRow) continue;
+    if (ring[i] >= elevations.size()) {
+      elevations.resize(ring[i] + std::size_t{1});
+      azimuths.resize(ring[i] + std::size_t{1});
+    }
+    elevations[ring[i]].push_back(fast_atan2(p.z(), std::hypot(p.x(), p.y())) * kDegrees);
+    double azimuth = fast_atan2(p.y(), p.x()) * kDegrees;
+    azimuths[ring[i]].push_back(static_cast<float>(azimuth < 0.0 ? azimuth + 360.0 : azimuth));
+  }
+  std::vector<std::pair<double, std::size_t>> rings;  // (median elevation, ring)
+  for (std::size_t r = 0; r < elevations.size(); ++r)
+    if (elevations[r].size() >= 16) rings.emplace_back(median(elevations[r]), r);
+  if (rings.size() < static_cast<std::size_t>(config.min_rows)) return std::nullopt;
+  std::sort(rings.begin(), rings.end());
+  std::vector<std::uint16_t> rank(elevations.size(), kNoRow);
+  RecoveredRows result;
+  std::vector<std::vector<float>> row_azimuths;
+  for (std::size_t k = 0; k < rings.size(); ++k) {
+    rank[rings[k].second] = static_cast<std::uint16_t>(k);
+    result.model.vertical_angles_deg.push_back(rings[k].first);
+    row_azimuths.push_back(std::move(azimuths[rings[k].second]));
+  }
+  result.ring.assign(points.size(), kNoRow);
+  std::size_t assigned = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (ring[i] < rank.size() && rank[ring[i]] != kNoRow) {
+      result.ring[i] = rank[ring[i]];
+      ++assigned;
+    }
+  result.assigned_share = points.empty() ? 0.0 : static_cast<double>(assigned) / static_cast<double>(points.size());
+  result.model.name = "ring-channel-" + std::to_string(rings.size());
+  result.model.horizontal_resolution_deg = azimuth_resolution_deg(row_azimuths);
+  result.model.min_range = config.min_range_m;
+  if (!(result.model.horizontal_resolution_deg > 0.0)) return std::nullopt;
+  return result;
+}
+
 }  // namespace mlidar::slam

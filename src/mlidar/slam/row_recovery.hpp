@@ -63,6 +63,14 @@ struct RecoveredRows {
   double width_ratio = 0.0;     ///< as RowRecoveryConfig::max_width_ratio
 };
 
+/// Rows of a scan that has a `ring` channel but no model (a folder of clouds):
+/// each ring's median elevation, rings renumbered by ascending elevation (the
+/// range image's row order), the median azimuth step within rings; none when
+/// fewer than min_rows rings hold 16 points or more. origin_z_m is 0 and every
+/// point of such a ring is assigned.
+std::optional<RecoveredRows> rows_from_ring_channel(std::span<const Eigen::Vector3f> points, std::span<const std::uint16_t> ring,
+                                                    const RowRecoveryConfig& config = {});
+
 /// Rows of `points` (LiDAR frame); none when the cloud shows no row structure.
 std::optional<RecoveredRows> recover_rows(std::span<const Eigen::Vector3f> points, const RowRecoveryConfig& config = {});
 
