@@ -45,6 +45,27 @@ void deskew_selection(const Scan& scan, std::span<const float> times, std::span<
     for (const std::uint32_t i : indices) out_times.push_back(times[i]);
 }
 
+/// Where this scan's range-image rows come from: the LiDAR's model; without
+/// one the scan's ring channel or rows recovered from its elevations
+/// (held in ws.recovered); a null-rows model when neither (voxel fallback).
+struct ScanRows {
+  const LidarModel* model;
+  std::span<const std::uint16_t> ring;
+  RowSource source;
+};
+
+ScanRows scan_rows(const Scan& scan, const LidarSetup& lidar, const FrontEndConfig& config, FrontEndWorkspace& ws, StageSeconds& seconds) {
+  ws.recovered.reset();
+  if (!lidar.model.vertical_angles_deg.empty()) return {&lidar.model, scan.ring, RowSource::kModel};
+  if (!config.recover_rows) return {&lidar.model, scan.ring, RowSource::kVoxelFallback};
+  StageTimer timer(seconds, Stage::kRangeImage);
+  ws.recovered = scan.has_ring() ? rows_from_ring_channel(scan.points, scan.ring, config.row_recovery)
+                                 : recover_rows(scan.points, config.row_recovery);
+  if (!ws.recovered) return {&lidar.model, scan.ring, RowSource::kVoxelFallback};
+  ws.recovered->model.max_range = lidar.model.max_range;
+  return {&ws.recovered->model, ws.recovered->ring, scan.has_ring() ? RowSource::kRingChannel : RowSource::kRecovered};
+}
+
 }  // namespace
 
 const char* stage_name(Stage stage) {
@@ -97,27 +118,10 @@ void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& l
                    const FrontEndConfig& config, FrontEndWorkspace& ws, LidarFeatures& out, StageSeconds& seconds) {
   std::vector<float> shifted;
   const std::span<const float> times = times_from_reference(scan, reference_stamp, shifted);
-  const LidarModel* model = &lidar.model;
-  std::span<const std::uint16_t> ring = scan.ring;
-  ws.recovered.reset();
-  RowSource source = lidar.model.vertical_angles_deg.empty() ? RowSource::kVoxelFallback : RowSource::kModel;
-  if (source == RowSource::kVoxelFallback && config.recover_rows) {
-    StageTimer timer(seconds, Stage::kRangeImage);
-    if (scan.has_ring()) {
-      ws.recovered = rows_from_ring_channel(scan.points, scan.ring, config.row_recovery);
-      if (ws.recovered) source = RowSource::kRingChannel;
-    } else {
-      ws.recovered = recover_rows(scan.points, config.row_recovery);
-      if (ws.recovered) source = RowSource::kRecovered;
-    }
-    if (ws.recovered) {
-      ws.recovered->model.max_range = lidar.model.max_range;
-      model = &ws.recovered->model;
-      ring = ws.recovered->ring;
-    }
-  }
+  const ScanRows rows = scan_rows(scan, lidar, config, ws, seconds);
+  const LidarModel* model = rows.model;
   out.rows = static_cast<int>(model->rings());
-  out.row_source = source;
+  out.row_source = rows.source;
   if (model->vertical_angles_deg.empty()) {
     std::vector<std::uint32_t> kept;
     {
@@ -133,7 +137,7 @@ void run_front_end(const Scan& scan, double reference_stamp, const LidarSetup& l
   }
   {
     StageTimer timer(seconds, Stage::kRangeImage);
-    build_range_image(scan.points, ring, *model, ws.image);
+    build_range_image(scan.points, rows.ring, *model, ws.image);
   }
   {
     StageTimer timer(seconds, Stage::kSegmentation);
