@@ -257,16 +257,17 @@ TEST(CliDoctor, NamesWhatWouldMisleadARunWithItsFixAndExitsOneOnlyForFailures) {
   EXPECT_GE(json["findings"].size(), 8u);
 
   const fs::path data = copy_of_small_dataset(dir / "data");
-  replace_scan(data / "scans/right/000005.pcd", 0, 0);       // empty: skipped by the jobs
-  replace_scan(data / "scans/right/000007.pcd", 50, 3);      // no per-point time
-  Scan mixed;  // half its points on a ring beyond the VLP-16's 16, no per-point time either
+  replace_scan(data / "scans/right/000005.pcd", 0, 0);   // empty: skipped by the jobs
+  replace_scan(data / "scans/right/000007.pcd", 50, 3);  // no per-point time
+  Scan mixed;                                            // half its points on a ring beyond the VLP-16's 16, no per-point time either
   for (int i = 0; i < 60; ++i) {
     mixed.points.emplace_back(5.0F, 0.01F * static_cast<float>(i), 0.0F);
     mixed.ring.push_back(i % 2 == 0 ? 3 : 20);
   }
-  io::write_cloud(data / "scans/right/000008.pcd", io::CloudFile{io::CloudFormat::kPcd, "binary", {0, 0, 0, 1, 0, 0, 0}, io::from_scan(mixed)});
+  io::write_cloud(data / "scans/right/000008.pcd",
+                  io::CloudFile{io::CloudFormat::kPcd, "binary", {0, 0, 0, 1, 0, 0, 0}, io::from_scan(mixed)});
   edit_yaml(data, "translation: [0, -0.477, -0.22]", "translation: [0, -477, -220]");  // millimetres
-  std::istringstream in(read_text(data / "times.txt"));  // a 1 s hole before frame 9
+  std::istringstream in(read_text(data / "times.txt"));                                // a 1 s hole before frame 9
   std::string stamps, line;
   for (int k = 0; std::getline(in, line); ++k) {
     char text[64];
@@ -284,11 +285,22 @@ TEST(CliDoctor, NamesWhatWouldMisleadARunWithItsFixAndExitsOneOnlyForFailures) {
   EXPECT_NE(finding(r.output, "extrinsics right").find("check the units"), std::string::npos) << r.output;
   EXPECT_NE(finding(r.output, "overlap right").rfind("warning", 0), std::string::npos) << r.output;
 
+  // No model (no vertical angles in dataset.yaml): the rows come from the ring field.
+  const fs::path no_model = copy_of_small_dataset(dir / "no_model");
+  const std::string angles = "    vertical_angles_deg: [-15, -13, -11, -9, -7, -5, -3, -1, 1, 3, 5, 7, 9, 11, 13, 15]\n";
+  edit_yaml(no_model, angles, "");
+  edit_yaml(no_model, angles, "");
+  const CliResult unmodelled = run_cli("doctor " + quoted(no_model.string()));
+  EXPECT_EQ(unmodelled.exit_code, 0) << unmodelled.output;
+  EXPECT_NE(finding(unmodelled.output, "rings right").find("no model: 16 rings from the ring field"), std::string::npos)
+      << unmodelled.output;
+
   // The base losing most of its scans: a failure, exit 1.
   for (int k = 0; k < 6; ++k) replace_scan(data / "scans/left" / ("00000" + std::to_string(k) + ".pcd"), 0, 0);
   const CliResult base = run_cli("doctor " + quoted(data.string()));
   EXPECT_EQ(base.exit_code, 1) << base.output;
-  EXPECT_NE(finding(base.output, "scans left").find("the base LiDAR lacks a usable scan in 6 of 12 frames"), std::string::npos) << base.output;
+  EXPECT_NE(finding(base.output, "scans left").find("the base LiDAR lacks a usable scan in 6 of 12 frames"), std::string::npos)
+      << base.output;
   EXPECT_EQ(run_cli("doctor " + quoted((dir / "nothing").string())).exit_code, 2) << "no such input: usage";
 }
 

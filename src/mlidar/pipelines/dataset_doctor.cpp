@@ -11,6 +11,7 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/geometry/kdtree.hpp"
 #include "mlidar/pipelines/frame_gaps.hpp"
+#include "mlidar/slam/row_recovery.hpp"
 
 namespace mlidar::pipelines {
 namespace {
@@ -135,6 +136,18 @@ void check_scans(const io::FrameSource& source, const std::vector<LidarTally>& t
   }
 }
 
+/// Where a LiDAR without a model gets its rows from, judged on its first scan (slam/frontend.hpp).
+std::string rows_without_model(const LidarTally& t) {
+  if (t.with_ring > 0)
+    return "no model: " + std::to_string(t.max_ring + 1) + " rings from the ring field, their angles measured from the points";
+  const auto rows = t.first ? slam::recover_rows(t.first->points) : std::nullopt;
+  if (rows)
+    return "no model and no ring field: the first scan shows " + std::to_string(rows->model.rings()) +
+           " scan rows (recovered from its elevations for the range-image front end; scans that show none use voxel samples)";
+  return "no model and no ring field, and the first scan shows no scan rows (a solid-state scanner, or sweeps merged while moving): "
+         "0.5 m voxel samples serve as features";
+}
+
 void check_times_and_rings(const io::FrameSource& source, const std::vector<LidarTally>& tallies, const DoctorConfig& config,
                            std::vector<Finding>& out) {
   for (std::size_t j = 0; j < tallies.size(); ++j) {
@@ -158,7 +171,9 @@ void check_times_and_rings(const io::FrameSource& source, const std::vector<Lida
                      "per-point times span at least " + number(t.min_time_span) + " s of a " + number(sweep) + " s sweep"});
     }
     const std::size_t rows = lidar.model.rings();
-    if (t.with_ring == 0) {
+    if (rows == 0) {
+      out.push_back({"rings", lidar.name, Severity::kOk, rows_without_model(t)});
+    } else if (t.with_ring == 0) {
       out.push_back({"rings", lidar.name, Severity::kOk, "no ring field: rows come from the elevation against the model's angles"});
     } else if (rows > 0 && t.max_ring + 1 != rows) {
       out.push_back({"rings", lidar.name, t.max_ring + 1 > rows ? Severity::kWarning : Severity::kOk,
