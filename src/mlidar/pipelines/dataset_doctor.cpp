@@ -9,6 +9,7 @@
 
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/core/median.hpp"
 #include "mlidar/geometry/kdtree.hpp"
 #include "mlidar/pipelines/frame_gaps.hpp"
 #include "mlidar/slam/row_recovery.hpp"
@@ -29,11 +30,6 @@ std::string frame_list(const std::vector<std::size_t>& frames, std::size_t max_l
   return out;
 }
 
-double median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
-  return values[values.size() / 2];
-}
-
 void check_stamps(const io::FrameSource& source, const DoctorConfig& config, std::vector<Finding>& out) {
   const std::vector<double>& stamps = source.stamps();
   if (stamps.size() < 2) {
@@ -42,7 +38,7 @@ void check_stamps(const io::FrameSource& source, const DoctorConfig& config, std
   }
   std::vector<double> steps;
   for (std::size_t k = 1; k < stamps.size(); ++k) steps.push_back(stamps[k] - stamps[k - 1]);
-  const double typical = median(steps);
+  const double typical = upper_median(steps);
   std::vector<std::size_t> gaps;
   for (std::size_t k = 0; k < steps.size(); ++k)
     if (steps[k] > config.gap_ratio * typical) gaps.push_back(k + 1);
@@ -175,7 +171,7 @@ void check_times_and_rings(const io::FrameSource& source, const std::vector<Lida
       out.push_back({"rings", lidar.name, Severity::kOk, rows_without_model(t)});
     } else if (t.with_ring == 0) {
       out.push_back({"rings", lidar.name, Severity::kOk, "no ring field: rows come from the elevation against the model's angles"});
-    } else if (rows > 0 && t.max_ring + 1 != rows) {
+    } else if (t.max_ring + 1 != rows) {
       out.push_back({"rings", lidar.name, t.max_ring + 1 > rows ? Severity::kWarning : Severity::kOk,
                      "ring values reach " + std::to_string(t.max_ring) + " for a model of " + std::to_string(rows) + " rows" +
                          (t.max_ring + 1 > rows ? ": points beyond the model's rows are dropped; check the model in dataset.yaml"

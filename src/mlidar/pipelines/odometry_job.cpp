@@ -1,6 +1,5 @@
 #include "mlidar/pipelines/odometry_job.hpp"
 
-#include <algorithm>
 #include <memory>
 
 #include <tbb/global_control.h>
@@ -47,27 +46,19 @@ Frame odometry_frame(const io::SourceFrame& source) {
 std::vector<std::string> front_end_lines(const std::vector<slam::FrameResult>& results, const std::vector<slam::LidarSetup>& lidars,
                                          bool recover_rows) {
   std::vector<std::string> lines;
+  const std::string of_frames = " of " + std::to_string(results.size()) + " frames (";
   for (std::size_t i = 0; i < lidars.size(); ++i) {
     if (!lidars[i].model.vertical_angles_deg.empty()) continue;
-    std::vector<int> recovered, channel;
-    std::size_t fallback = 0;
-    for (const slam::FrameResult& r : results) {
-      if (i >= r.lidar_row_source.size()) continue;
-      if (r.lidar_row_source[i] == slam::RowSource::kRecovered) recovered.push_back(r.lidar_rows[i]);
-      if (r.lidar_row_source[i] == slam::RowSource::kRingChannel) channel.push_back(r.lidar_rows[i]);
-      fallback += r.lidar_row_source[i] == slam::RowSource::kVoxelFallback ? 1 : 0;
-    }
-    const auto median_rows = [](std::vector<int> rows) {
-      std::sort(rows.begin(), rows.end());
-      return std::to_string(rows[rows.size() / 2]);
-    };
+    const FrontEndTally tally = front_end_tally(results, i);
+    const auto median_rows = [](const std::vector<int>& rows) { return std::to_string(rows[rows.size() / 2]); };
     std::string line = "LiDAR '" + lidars[i].name + "' has no model: ";
-    if (!channel.empty())
-      line += "rows from its ring channel in " + std::to_string(channel.size()) + " of " + std::to_string(results.size()) + " frames (" +
-              median_rows(channel) + " rings, angles measured from the points); ";
-    if (!recovered.empty())
-      line += "scan rows recovered from the elevations in " + std::to_string(recovered.size()) + " of " + std::to_string(results.size()) +
-              " frames (" + median_rows(recovered) + " rows, median), range-image features and voxel samples; ";
+    if (!tally.ring_channel_rows.empty())
+      line += "rows from its ring channel in " + std::to_string(tally.ring_channel_rows.size()) + of_frames +
+              median_rows(tally.ring_channel_rows) + " rings, angles measured from the points); ";
+    if (!tally.recovered_rows.empty())
+      line += "scan rows recovered from the elevations in " + std::to_string(tally.recovered_rows.size()) + of_frames +
+              median_rows(tally.recovered_rows) + " rows, median), range-image features and voxel samples; ";
+    const std::size_t fallback = tally.frames_from(slam::RowSource::kVoxelFallback);
     if (fallback > 0 && !recover_rows)
       line += "rows are not recovered (odometry.recover_rows: false): 0.5 m voxel samples served as plane features";
     else if (fallback > 0)
@@ -108,21 +99,11 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   for (std::size_t k = 0; k < results.size(); ++k) {
     const slam::FrameResult& r = results[k];
     summary.degenerate_frames += r.registration.degenerate ? 1 : 0;
-    if (r.registration.degenerate) {
-      const std::string words = base_axis_words(weak_translation_base(r));
-      auto entry = std::find_if(summary.degenerate_directions.begin(), summary.degenerate_directions.end(),
-                                [&words](const auto& e) { return e.first == words; });
-      if (entry == summary.degenerate_directions.end())
-        summary.degenerate_directions.emplace_back(words, 1);
-      else
-        ++entry->second;
-    }
     summary.lost_frames += r.lost() ? 1 : 0;
     if (r.suspect()) summary.suspect_frames.push_back(k);
     for (const double s : r.seconds) summary.mean_frame_seconds += s / static_cast<double>(results.size());
   }
-  std::stable_sort(summary.degenerate_directions.begin(), summary.degenerate_directions.end(),
-                   [](const auto& a, const auto& b) { return a.second > b.second; });
+  summary.degenerate_directions = degenerate_direction_counts(results);
   summary.gaps = gaps.summary_lines();
   summary.front_end = front_end_lines(results, lidars, config.front_end.recover_rows);
   summary.base_failure = gaps.base_failure(job.max_base_gaps, source.reference_index());

@@ -51,18 +51,11 @@ namespace {
 nlohmann::json front_end_summary(const std::vector<std::string>& names, const std::vector<slam::FrameResult>& frames) {
   nlohmann::json summary = nlohmann::json::object();
   for (std::size_t i = 0; i < names.size(); ++i) {
+    const FrontEndTally tally = front_end_tally(frames, i);
     nlohmann::json by_source = nlohmann::json::object();
-    for (const auto source :
-         {slam::RowSource::kModel, slam::RowSource::kRingChannel, slam::RowSource::kRecovered, slam::RowSource::kVoxelFallback})
-      by_source[slam::row_source_name(source)] = 0;
-    std::vector<int> rows;
-    for (const slam::FrameResult& f : frames) {
-      if (i >= f.lidar_row_source.size()) continue;
-      const std::string name = slam::row_source_name(f.lidar_row_source[i]);
-      by_source[name] = by_source[name].get<int>() + 1;
-      if (f.lidar_row_source[i] == slam::RowSource::kRecovered) rows.push_back(f.lidar_rows[i]);
-    }
-    std::sort(rows.begin(), rows.end());
+    for (std::size_t source = 0; source < tally.frames.size(); ++source)
+      by_source[slam::row_source_name(static_cast<slam::RowSource>(source))] = tally.frames[source];
+    const std::vector<int>& rows = tally.recovered_rows;
     nlohmann::json recovered_rows = nullptr;
     if (!rows.empty()) recovered_rows = {{"min", rows.front()}, {"median", rows[rows.size() / 2]}, {"max", rows.back()}};
     summary[names[i]] = {{"frames_by_source", by_source}, {"recovered_rows", recovered_rows}};
@@ -71,6 +64,35 @@ nlohmann::json front_end_summary(const std::vector<std::string>& names, const st
 }
 
 }  // namespace
+
+FrontEndTally front_end_tally(const std::vector<slam::FrameResult>& frames, std::size_t lidar) {
+  FrontEndTally tally;
+  for (const slam::FrameResult& f : frames) {
+    if (lidar >= f.lidar_row_source.size()) continue;
+    const slam::RowSource source = f.lidar_row_source[lidar];
+    ++tally.frames[static_cast<std::size_t>(source)];
+    if (source == slam::RowSource::kRecovered) tally.recovered_rows.push_back(f.lidar_rows[lidar]);
+    if (source == slam::RowSource::kRingChannel) tally.ring_channel_rows.push_back(f.lidar_rows[lidar]);
+  }
+  std::sort(tally.recovered_rows.begin(), tally.recovered_rows.end());
+  std::sort(tally.ring_channel_rows.begin(), tally.ring_channel_rows.end());
+  return tally;
+}
+
+std::vector<std::pair<std::string, std::size_t>> degenerate_direction_counts(const std::vector<slam::FrameResult>& frames) {
+  std::vector<std::pair<std::string, std::size_t>> counts;
+  for (const slam::FrameResult& f : frames) {
+    if (!f.registration.degenerate) continue;
+    const std::string words = base_axis_words(weak_translation_base(f));
+    const auto entry = std::find_if(counts.begin(), counts.end(), [&words](const auto& e) { return e.first == words; });
+    if (entry == counts.end())
+      counts.emplace_back(words, 1);
+    else
+      ++entry->second;
+  }
+  std::stable_sort(counts.begin(), counts.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  return counts;
+}
 
 std::string base_axis_words(const Vec3& direction_base) {
   Eigen::Index axis = 0;
@@ -99,19 +121,16 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
     json["stages"][slam::stage_name(static_cast<slam::Stage>(s))] = timing_summary(stage);
   }
   nlohmann::json per_frame = nlohmann::json::array();
-  nlohmann::json degenerate_directions = nlohmann::json::object();
   for (const auto& f : frames) {
     nlohmann::json weak = nullptr, weak_words = nullptr;
     if (f.registration.degenerate) {
       const Vec3 direction = weak_translation_base(f);
       weak = {direction.x(), direction.y(), direction.z()};
       weak_words = base_axis_words(direction);
-      degenerate_directions[weak_words.get<std::string>()] = degenerate_directions.value(weak_words.get<std::string>(), 0) + 1;
     }
     nlohmann::json front_end;
-    for (std::size_t i = 0; i < names.size() && i < f.lidar_rows.size(); ++i) {
+    for (std::size_t i = 0; i < names.size() && i < f.lidar_rows.size(); ++i)
       front_end[names[i]] = {{"rows", f.lidar_rows[i]}, {"source", slam::row_source_name(f.lidar_row_source[i])}};
-    }
     double sum = 0.0;
     for (const double v : f.seconds) sum += v;
     total.push_back(sum);
@@ -147,6 +166,8 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["points_in"] = timing_summary(points_in);
   json["features_out"] = timing_summary(features_out);
   json["degenerate_frames"] = degenerate;
+  nlohmann::json degenerate_directions = nlohmann::json::object();
+  for (const auto& [words, count] : degenerate_direction_counts(frames)) degenerate_directions[words] = count;
   json["degenerate_directions"] = degenerate_directions;
   json["retried_frames"] = retried;
   json["lost_frames"] = lost;

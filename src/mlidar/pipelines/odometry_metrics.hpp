@@ -1,8 +1,10 @@
 #pragma once
 // metrics.json and map.ply of an odometry run (see odometry_job.hpp).
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -17,8 +19,9 @@ namespace mlidar::pipelines {
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars);
 
 /// A frame's feature selection (null when off): {method, features, searched, matched, budget, selected,
-/// log_det_full and translation_observability_full (null where not evaluated), log_det_selected, degenerate_scene, stopped_by_time, seconds, per_lidar: {NAME: {features, selected}}}.
-/// (shared with slam's metrics.json; `selected` is the sum over the LiDARs: the fallback's all).
+/// log_det_full and translation_observability_full (null where not evaluated), log_det_selected, degenerate_scene, stopped_by_time,
+/// seconds, per_lidar: {NAME: {features, selected}}}. (shared with slam's metrics.json; `selected` is the sum over the LiDARs: the
+/// fallback's all).
 nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summary, const std::vector<std::string>& lidar_names);
 
 /// The base axis a unit direction lies closest to, in words: "x (forward-backward)",
@@ -27,6 +30,18 @@ std::string base_axis_words(const Vec3& direction_base);
 
 /// A degenerate frame's weak translation in the base frame (zero when the frame is not degenerate).
 Vec3 weak_translation_base(const slam::FrameResult& frame);
+
+/// Degenerate frames per weak direction (base_axis_words), most first (ties in order of first appearance).
+std::vector<std::pair<std::string, std::size_t>> degenerate_direction_counts(const std::vector<slam::FrameResult>& frames);
+
+/// How the front end made one LiDAR's features over a run.
+struct FrontEndTally {
+  std::array<std::size_t, 4> frames{};  ///< per slam::RowSource, in its order
+  std::vector<int> recovered_rows;      ///< rows of each frame whose rows were recovered, ascending
+  std::vector<int> ring_channel_rows;   ///< rows of each frame whose rows came from the ring channel, ascending
+  std::size_t frames_from(slam::RowSource source) const { return frames[static_cast<std::size_t>(source)]; }
+};
+FrontEndTally front_end_tally(const std::vector<slam::FrameResult>& frames, std::size_t lidar);
 
 /// {mean, p50, p95, max} of `values` (zeros when empty).
 nlohmann::json timing_summary(std::vector<double> values);

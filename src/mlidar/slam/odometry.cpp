@@ -199,7 +199,15 @@ RegistrationConfig Odometry::frame_registration(const SE3& prediction, double th
   return config;
 }
 
-TrustRule Odometry::trust_rule() const { return {config_.trust, residual_scale_ * recent_residuals_.median_m()}; }
+double Odometry::residual_scale() const {
+  std::size_t voxel_samples = 0;
+  for (const LidarFeatures& f : features_) voxel_samples += f.voxel_samples;
+  const std::size_t all = frame_features_.edges.size() + frame_features_.planes.size();
+  const double share = all > 0 ? static_cast<double>(voxel_samples) / static_cast<double>(all) : 0.0;
+  return 1.0 + (config_.trust.voxel_residual_ratio - 1.0) * share;
+}
+
+TrustRule Odometry::trust_rule() const { return {config_.trust, residual_scale() * recent_residuals_.median_m()}; }
 
 void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
   // Eq 4.12 again with the velocity from the previous centroid to this registration: the
@@ -297,9 +305,7 @@ FrameResult Odometry::process(const Frame& frame) {
     run_front_end(frame.scans[i], centroid_stamp, lidars_[i], velocity, config_.front_end, workspaces_[i], features_[i], per_lidar[i]);
   });
   clear_features(frame_features_);
-  std::size_t voxel_features = 0;
   for (std::size_t i = 0; i < lidars_.size(); ++i) {
-    voxel_features += features_[i].voxel_samples;
     for (std::size_t s = 0; s < kStageCount; ++s) result.seconds[s] += per_lidar[i][s];
     result.points_in += frame.scans[i].size();
     result.lidar_features.push_back(features_[i].edges.size() + features_[i].planes.size());
@@ -309,9 +315,6 @@ FrameResult Odometry::process(const Frame& frame) {
   }
   result.edge_features = frame_features_.edges.size();
   result.plane_features = frame_features_.planes.size();
-  const std::size_t all_features = result.edge_features + result.plane_features;
-  residual_scale_ = 1.0 + (config_.trust.voxel_residual_ratio - 1.0) *
-                              (all_features > 0 ? static_cast<double>(voxel_features) / static_cast<double>(all_features) : 0.0);
 
   auto start = std::chrono::steady_clock::now();
   SE3 T_world_centroid = SE3::identity();
@@ -353,7 +356,7 @@ FrameResult Odometry::process(const Frame& frame) {
   }
   // Every registered frame, suspect ones too: a lasting change of the fit (a rougher scene) moves the
   // median within half the history instead of leaving every later frame suspect and the map frozen.
-  if (centroid_poses_.size() >= 2 && !result.lost()) recent_residuals_.add(result.registration.mean_residual_m / residual_scale_);
+  if (centroid_poses_.size() >= 2 && !result.lost()) recent_residuals_.add(result.registration.mean_residual_m / residual_scale());
   result.seconds[static_cast<std::size_t>(Stage::kMapUpdate)] += seconds_since(start);
   result.T_world_base = centroid_poses_.back().T_world_base * latest_velocity().pose_at(-result.centroid_time);
   return result;

@@ -152,6 +152,8 @@ class Odometry {
   RegistrationResult register_robustly(const SE3& prediction, double centroid_stamp, const MotionDeskew* motion, FrameResult& frame);
   /// After a registration with MotionDeskew: the frame's features deskewed with the velocity it ended with.
   void apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered);
+  /// 1 + (TrustConfig::voxel_residual_ratio - 1) x the share of voxel samples among this frame's features.
+  double residual_scale() const;
   TrustRule trust_rule() const;
   /// The registration settings of this frame: with adaptive feature selection,
   /// lambda is evaluated again every degeneracy_interval_s and sets M (sec 5.4.4).
@@ -176,10 +178,9 @@ class Odometry {
   VoxelMap plane_map_;
   std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid
   /// Mean |r| of the last registered (not lost) frames, each divided by its
-  /// frame's residual_scale_ (TrustConfig::voxel_residual_ratio).
+  /// frame's residual_scale().
   ResidualHistory recent_residuals_;
-  double residual_scale_ = 1.0;  ///< this frame's
-  RegistrationConfig registration_;  ///< this frame's (frame_registration)
+  RegistrationConfig registration_;                                     ///< this frame's (frame_registration)
   double degeneracy_stamp_ = -std::numeric_limits<double>::infinity();  ///< when lambda was last evaluated
   bool degenerate_scene_ = false;
   double first_stamp_ = 0.0;

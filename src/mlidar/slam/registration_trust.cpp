@@ -51,10 +51,10 @@ bool TrustRule::trusted(const RegistrationResult& r) const { return acceptable(r
 
 namespace {
 
-bool distinct(const SE3& a, const SE3& b, const TrustConfig& config) {
+/// True when b lies farther than `translation_m` from a or is turned more than `rotation_deg` from it.
+bool farther_than(const SE3& a, const SE3& b, double translation_m, double rotation_deg) {
   const SE3 between = a.inverse() * b;
-  const double rotation_deg = so3_log(between.rotation()).norm() * 180.0 / std::numbers::pi;
-  return between.translation().norm() > config.distinct_translation_m || rotation_deg > config.distinct_rotation_deg;
+  return between.translation().norm() > translation_m || so3_log(between.rotation()).norm() * 180.0 / std::numbers::pi > rotation_deg;
 }
 
 }  // namespace
@@ -74,7 +74,8 @@ Choice choose_registration(std::span<const RegistrationResult> candidates, const
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     if (i == choice.best || !rule.acceptable(candidates[i])) continue;
     if (candidates[i].mean_residual_m > rule.config.ambiguity_ratio * best.mean_residual_m) continue;
-    if (!distinct(candidates[i].T_world_base, best.T_world_base, rule.config)) continue;
+    if (!farther_than(candidates[i].T_world_base, best.T_world_base, rule.config.distinct_translation_m, rule.config.distinct_rotation_deg))
+      continue;
     choice.trust = Trust::kAmbiguous;
     choice.rival = i;
     break;
@@ -84,11 +85,9 @@ Choice choose_registration(std::span<const RegistrationResult> candidates, const
 
 Trust judge_degenerate_correction(Trust trust, const RegistrationResult& r, const SE3& prediction, const TrustConfig& config) {
   if (trust != Trust::kTrusted || !r.degenerate) return trust;
-  const SE3 correction = prediction.inverse() * r.T_world_base;
-  const double rotation_deg = so3_log(correction.rotation()).norm() * 180.0 / std::numbers::pi;
-  const bool far =
-      correction.translation().norm() > config.degenerate_max_correction_m || rotation_deg > config.degenerate_max_correction_deg;
-  return far ? Trust::kDegenerate : trust;
+  return farther_than(prediction, r.T_world_base, config.degenerate_max_correction_m, config.degenerate_max_correction_deg)
+             ? Trust::kDegenerate
+             : trust;
 }
 
 }  // namespace mlidar::slam

@@ -14,6 +14,12 @@ namespace {
 
 constexpr double kDegrees = 180.0 / std::numbers::pi;
 
+/// Azimuth of p in [0, 360) deg.
+double azimuth_deg(const Eigen::Vector3f& p) {
+  const double azimuth = fast_atan2(p.y(), p.x()) * kDegrees;
+  return azimuth < 0.0 ? azimuth + 360.0 : azimuth;
+}
+
 /// The points rows are recovered from: finite, beyond the minimum range.
 struct UsablePoints {
   std::vector<std::uint32_t> index;  ///< into the input
@@ -28,8 +34,7 @@ UsablePoints usable_points(std::span<const Eigen::Vector3f> points, const RowRec
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f& p = points[i];
     if (!p.allFinite() || p.norm() < config.min_range_m) continue;
-    double azimuth = fast_atan2(p.y(), p.x()) * kDegrees;
-    if (azimuth < 0.0) azimuth += 360.0;
+    const double azimuth = azimuth_deg(p);
     usable.index.push_back(static_cast<std::uint32_t>(i));
     usable.rho.push_back(std::hypot(p.x(), p.y()));
     usable.z.push_back(p.z());
@@ -134,7 +139,7 @@ std::vector<int> sector_shifts(const std::vector<int>& bins, const UsablePoints&
 }
 
 std::vector<int> elevation_bins(const UsablePoints& usable, double origin_z, const Histograms& h) {
-  std::vector<int> bins(usable.index.size());
+  std::vector<int> bins(usable.rho.size());
   for (std::size_t k = 0; k < bins.size(); ++k) bins[k] = h.bin(fast_atan2(usable.z[k] - origin_z, usable.rho[k]) * kDegrees);
   return bins;
 }
@@ -154,6 +159,36 @@ double sharpness(const std::vector<double>& counts) {
     total += c;
   }
   return total > 0.0 ? squares / total : 0.0;
+}
+
+/// The beams' height above the origin that makes the corrected histogram
+/// sharpest: every second step of the grid, then the two beside the best, on
+/// at most kSearchPoints of the points (every stride-th).
+double best_origin_z(const UsablePoints& usable, const Histograms& h, int max_step, const RowRecoveryConfig& config) {
+  constexpr std::size_t kSearchPoints = 16000;
+  const std::size_t stride = std::max<std::size_t>(1, usable.rho.size() / kSearchPoints);
+  UsablePoints search;
+  for (std::size_t k = 0; k < usable.rho.size(); k += stride) {
+    search.rho.push_back(usable.rho[k]);
+    search.z.push_back(usable.z[k]);
+    search.sector.push_back(usable.sector[k]);
+  }
+  double best_sharpness = -1.0, origin_z = 0.0;
+  const auto try_origin = [&](double z0) {
+    const std::vector<int> bins = elevation_bins(search, z0, h);
+    const double value = sharpness(corrected_counts(bins, sector_shifts(bins, search, h, max_step), search, h));
+    if (value > best_sharpness + 1e-12) {
+      best_sharpness = value;
+      origin_z = z0;
+    }
+  };
+  const int steps = static_cast<int>(std::lround(config.origin_z_range_m / config.origin_z_step_m));
+  for (int step = -steps; step <= steps; step += 2) try_origin(step * config.origin_z_step_m);
+  const double coarse = origin_z;
+  for (const double side : {-1.0, 1.0})
+    if (std::abs(coarse + side * config.origin_z_step_m) <= config.origin_z_range_m + 1e-12)
+      try_origin(coarse + side * config.origin_z_step_m);
+  return origin_z;
 }
 
 /// Peaks of the smoothed histogram, those with a shallow valley between them merged.
@@ -213,32 +248,7 @@ std::optional<RecoveredRows> recover_rows(std::span<const Eigen::Vector3f> point
   const Histograms h(config.bin_deg, std::max(1, static_cast<int>(std::lround(360.0 / config.sector_deg))));
   const int max_step = std::max(1, static_cast<int>(std::lround(config.max_step_deg / config.bin_deg)));
 
-  // z0 is searched on at most kSearchPoints of the points (every stride-th), then the shifts found on all of them.
-  constexpr std::size_t kSearchPoints = 16000;
-  const std::size_t stride = std::max<std::size_t>(1, usable.index.size() / kSearchPoints);
-  UsablePoints search;
-  for (std::size_t k = 0; k < usable.index.size(); k += stride) {
-    search.rho.push_back(usable.rho[k]);
-    search.z.push_back(usable.z[k]);
-    search.sector.push_back(usable.sector[k]);
-  }
-  search.index.resize(search.rho.size());
-  double best_sharpness = -1.0, origin_z = 0.0;
-  const auto try_origin = [&](double z0) {
-    const std::vector<int> candidate_bins = elevation_bins(search, z0, h);
-    const double value = sharpness(corrected_counts(candidate_bins, sector_shifts(candidate_bins, search, h, max_step), search, h));
-    if (value > best_sharpness + 1e-12) {
-      best_sharpness = value;
-      origin_z = z0;
-    }
-  };
-  // Every second step of the grid, then the two beside the best.
-  const int steps = static_cast<int>(std::lround(config.origin_z_range_m / config.origin_z_step_m));
-  for (int step = -steps; step <= steps; step += 2) try_origin(step * config.origin_z_step_m);
-  const double coarse = origin_z;
-  for (const double side : {-1.0, 1.0})
-    if (std::abs(coarse + side * config.origin_z_step_m) <= config.origin_z_range_m + 1e-12)
-      try_origin(coarse + side * config.origin_z_step_m);
+  const double origin_z = best_origin_z(usable, h, max_step, config);
   const std::vector<int> bins = elevation_bins(usable, origin_z, h);
   const std::vector<int> shift = sector_shifts(bins, usable, h, max_step);
 
@@ -320,8 +330,7 @@ std::optional<RecoveredRows> rows_from_ring_channel(std::span<const Eigen::Vecto
       azimuths.resize(ring[i] + std::size_t{1});
     }
     elevations[ring[i]].push_back(fast_atan2(p.z(), std::hypot(p.x(), p.y())) * kDegrees);
-    double azimuth = fast_atan2(p.y(), p.x()) * kDegrees;
-    azimuths[ring[i]].push_back(static_cast<float>(azimuth < 0.0 ? azimuth + 360.0 : azimuth));
+    azimuths[ring[i]].push_back(static_cast<float>(azimuth_deg(p)));
   }
   std::vector<std::pair<double, std::size_t>> rings;  // (median elevation, ring)
   for (std::size_t r = 0; r < elevations.size(); ++r)
