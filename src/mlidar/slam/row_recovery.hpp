@@ -40,11 +40,12 @@ struct RowRecoveryConfig {
   int min_rows = 8;                 ///< fewer: not a multi-beam spinning scan
   double min_assigned_share = 0.8;  ///< of the usable points, inside a row
   /// Median over rows of (std of its corrected elevations) / (spacing to its
-  /// nearest neighbour row) at most this: a uniform spread gives ~0.29. Real
-  /// single sweeps: 0.02-0.05 (BALM's still keyframes, exactly the sensor's 64
-  /// rows); keyframes merged from sweeps taken while moving: 0.07-0.22 with
-  /// 70-140 "rows" that interleave the sweeps' beams, whose range images made
-  /// BALM pairs 0.5 m off (docs/benchmarks.md "Ring-less clouds").
+  /// nearest neighbour row) at most this: a uniform spread gives ~0.29. BALM's
+  /// still keyframes 20-25: 0.025-0.030 with exactly the sensor's 64 rows;
+  /// keyframes merged from sweeps taken while moving: 0.075 (frame 22, 128
+  /// peaks: two sweeps) to 0.22 with 108-138 peaks interleaving the sweeps'
+  /// beams, whose range images made BALM pairs 0.5 m off
+  /// (docs/benchmarks.md "Ring-less clouds").
   double max_width_ratio = 0.06;
   double merge_valley_ratio = 0.5;  ///< peaks whose valley exceeds this x the lower peak are one row
   double min_range_m = 0.5;         ///< nearer points are ignored (and get no row)
