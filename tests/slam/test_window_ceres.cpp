@@ -70,5 +70,11 @@ TEST(CeresWindow, RejectsAProblemWithAPrior) {
   EXPECT_THROW(solve_window_ceres(window.problem, window.initial), std::invalid_argument);
 }
 
+TEST(CeresWindow, RejectsAMapAnchoredAtAPose) {
+  NoisyWindow window = noisy_window(true, 29);
+  window.problem.anchor = {0, window.initial.T_world_base[0]};
+  EXPECT_THROW(solve_window_ceres(window.problem, window.initial), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace mlidar::slam

@@ -59,6 +59,7 @@ struct EdgeTerm {
 CeresWindowResult solve_window_ceres(const WindowProblem& problem, const WindowState& initial, const CeresWindowOptions& options) {
   check_problem(problem, initial);
   if (!problem.prior.variables.empty()) throw std::invalid_argument("solve_window_ceres: a marginalization prior is not modelled");
+  if (problem.anchor.frame >= 0) throw std::invalid_argument("solve_window_ceres: a map anchored at a window pose is not modelled");
   std::vector<Block> poses, extrinsics;
   for (const SE3& T : initial.T_world_base) poses.push_back(to_block(T));
   for (const SE3& T : initial.T_base_lidar) extrinsics.push_back(to_block(T));

@@ -7,7 +7,8 @@
 // (SO(3) x R^3), residuals by automatic differentiation. It exists to compare
 // against the hand-written solver (window_solver.hpp), as issue 9 asks:
 // docs/benchmarks.md "Solver: Ceres vs hand-written". The marginalization
-// prior is not modelled (the compared problems carry none).
+// prior and the map anchored at the pivot are not modelled (the compared
+// problems carry neither).
 #include "mlidar/slam/window_problem.hpp"
 
 namespace mlidar::slam {
@@ -26,7 +27,7 @@ struct CeresWindowResult {
   bool converged = false;
 };
 
-/// Throws std::invalid_argument for an inconsistent problem or one with a prior.
+/// Throws std::invalid_argument for an inconsistent problem or one with a prior or an anchored map.
 CeresWindowResult solve_window_ceres(const WindowProblem& problem, const WindowState& initial, const CeresWindowOptions& options = {});
 
 }  // namespace mlidar::slam

@@ -7,23 +7,28 @@
 #include <Eigen/Eigenvalues>
 
 #include "mlidar/slam/window_linearize.hpp"
+#include "mlidar/slam/window_solver.hpp"
 
 namespace mlidar::slam {
 namespace {
 
 bool touches(const std::vector<VariableId>& ids, VariableId id) { return std::find(ids.begin(), ids.end(), id) != ids.end(); }
 
-/// The variables of the terms on `frame`: the pose, the extrinsics its correspondences use, the prior's.
+/// The variables of the terms on `frame`: the pose, the poses and extrinsics its correspondences use (all of
+/// them when the map is anchored at `frame`), the anchor, the prior's.
 std::vector<VariableId> involved_variables(const WindowProblem& terms, const WindowState& state, int frame) {
   std::vector<VariableId> ids{{VariableId::Kind::kPose, frame}};
-  const auto add_lidar = [&](int lidar) {
-    const VariableId id{VariableId::Kind::kExtrinsic, lidar};
+  const auto add = [&](VariableId id) {
     if (!touches(ids, id)) ids.push_back(id);
   };
-  for (const PlaneCorrespondence& c : terms.planes) add_lidar(c.lidar);
-  for (const EdgeCorrespondence& c : terms.edges) add_lidar(c.lidar);
-  for (const VariableId& id : terms.prior.variables)
-    if (!touches(ids, id)) ids.push_back(id);
+  const auto add_term = [&](int term_frame, int lidar) {
+    add({VariableId::Kind::kPose, term_frame});
+    add({VariableId::Kind::kExtrinsic, lidar});
+  };
+  for (const PlaneCorrespondence& c : terms.planes) add_term(c.frame, c.lidar);
+  for (const EdgeCorrespondence& c : terms.edges) add_term(c.frame, c.lidar);
+  if (terms.anchor.frame >= 0 && !(terms.planes.empty() && terms.edges.empty())) add({VariableId::Kind::kPose, terms.anchor.frame});
+  for (const VariableId& id : terms.prior.variables) add(id);
   std::erase_if(ids, [&](const VariableId& id) { return state.fixed(id); });
   return ids;
 }
@@ -48,10 +53,11 @@ SchurComplement schur_complement(const Eigen::MatrixXd& H, const Eigen::VectorXd
     if (std::find(marginalized.begin(), marginalized.end(), k) == marginalized.end()) out.kept_columns.push_back(k);
   const Eigen::MatrixXd H_mm = H(marginalized, marginalized);
   const Eigen::MatrixXd H_rm = H(out.kept_columns, marginalized);
-  const Eigen::LDLT<Eigen::MatrixXd> H_mm_ldlt(H_mm);
-  // Eq 4.41.
-  out.H = H(out.kept_columns, out.kept_columns) - H_rm * H_mm_ldlt.solve(H_rm.transpose());
-  out.g = g(out.kept_columns) - H_rm * H_mm_ldlt.solve(g(marginalized));
+  // Eq 4.41, with the pseudo-inverse of H_mm: a direction of the marginalized state that no term observes
+  // (a corridor's axis) carries nothing into the prior instead of an infinite gain.
+  const Eigen::MatrixXd H_mm_inverse = symmetric_pseudo_inverse(H_mm);
+  out.H = H(out.kept_columns, out.kept_columns) - H_rm * H_mm_inverse * H_rm.transpose();
+  out.g = g(out.kept_columns) - H_rm * (H_mm_inverse * g(marginalized));
   out.H = 0.5 * (out.H + out.H.transpose());
   return out;
 }
@@ -72,11 +78,14 @@ void factor_prior(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::Mat
 
 LinearPrior marginalize_frame(const WindowProblem& problem, const WindowState& state, int frame, double huber_delta_m) {
   check_problem(problem, state);
+  // The terms on `frame`: its own correspondences, or every one when the map is attached to it.
+  const bool anchor = problem.anchor.frame == frame;
   WindowProblem terms;
   std::copy_if(problem.planes.begin(), problem.planes.end(), std::back_inserter(terms.planes),
-               [frame](const PlaneCorrespondence& c) { return c.frame == frame; });
+               [&](const PlaneCorrespondence& c) { return anchor || c.frame == frame; });
   std::copy_if(problem.edges.begin(), problem.edges.end(), std::back_inserter(terms.edges),
-               [frame](const EdgeCorrespondence& c) { return c.frame == frame; });
+               [&](const EdgeCorrespondence& c) { return anchor || c.frame == frame; });
+  terms.anchor = problem.anchor;
   terms.prior = problem.prior;
   const std::vector<VariableId> ids = involved_variables(terms, state, frame);
   if (ids.empty()) return {};  // a fixed pose whose terms touch no variable: nothing to carry
@@ -113,6 +122,7 @@ void shift_window(WindowProblem& problem, WindowState& state, LinearPrior prior,
   state.pose_fixed.push_back(false);
   problem.planes.clear();
   problem.edges.clear();
+  problem.anchor = {};
   problem.prior = std::move(prior);
 }
 

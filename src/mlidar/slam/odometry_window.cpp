@@ -37,8 +37,11 @@ OdometryWindowUpdate OdometryWindow::add(std::size_t frame, LidarFrameFeatures f
   const auto capacity = static_cast<std::size_t>(config_.size + 1);
   const auto pivot = static_cast<std::size_t>(config_.pivot);
   if (entries_.size() == capacity) {
-    // Eq 4.39-4.44: the oldest state into the prior, then the shift; the frame at p moves to p - 1 and is settled.
-    LinearPrior prior = marginalize_frame(problem_, state_, 0, config_.solver.huber_delta_m);
+    // Sec 4.7.5, eq 4.39-4.44: the pivot into the prior (it is fixed in the solves, a variable here), then the
+    // shift; the frame at p moves to p - 1 and is the new pivot, settled.
+    WindowState pivot_free = state_;
+    pivot_free.pose_fixed[pivot - 1] = false;
+    LinearPrior prior = marginalize_frame(problem_, pivot_free, static_cast<int>(pivot - 1), config_.solver.huber_delta_m);
     shift_window(problem_, state_, std::move(prior), initial);
     entries_.pop_front();
     entries_.push_back({frame, std::move(features), T_estimate_output});
@@ -83,9 +86,11 @@ void OdometryWindow::settle(std::size_t index) {
 }
 
 std::size_t OdometryWindow::solve() {
-  // Eq 4.22: the variable frames' features against the local map, extrinsics fixed.
+  // Eq 4.22: the variable frames' features against the local map attached to the pivot, extrinsics fixed.
   problem_.planes.clear();
   problem_.edges.clear();
+  const auto pivot = static_cast<std::size_t>(config_.pivot - 1);
+  problem_.anchor = pivot < entries_.size() ? MapAnchor{static_cast<int>(pivot), state_.T_world_base[pivot]} : MapAnchor{};
   const MapView map{edge_map_, plane_map_, config_.registration};
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     if (state_.pose_fixed[i]) continue;

@@ -2,24 +2,26 @@
 // The sliding window over the trusted poses: M-LOAM's pure-odometry mode
 // (thesis eq 4.22, Sec. 4.7) behind the scan-to-map odometry.
 //
-// The window holds N + 1 frames (oldest first). The first p (the pivot, Table
-// 4.2: N = 4, p = 2) are fixed: their features are in the window's own local
-// map, at their final poses. The last N + 1 - p are variables: every trusted
-// LiDAR's features at those frames (in the base frame at the frame's time
-// centroid, i.e. with the fixed extrinsics already applied: eq 4.22's
-// T_base_lidar are constants, so all LiDARs' features act as one set) are
-// matched against that map and the window is solved (window_solver.hpp).
+// The window holds N + 1 frames (oldest first). The first p (Table 4.2: N = 4,
+// p = 2) are fixed; the last of them, at index p - 1, is the pivot. Fixed
+// frames' features are in the window's local map at their final poses (with
+// the settled frames before them, within local_map_radius_m: the thesis's map
+// holds the window's frames only). The last N + 1 - p frames are variables:
+// every trusted LiDAR's features at those frames (in the base frame at the
+// frame's time centroid, i.e. with the fixed extrinsics already applied:
+// eq 4.22's T_base_lidar are constants, so all LiDARs' features act as one
+// set) are matched against that map, which is attached to the pivot
+// (MapAnchor: each term is r(T_pivot^-1 T_k x), eq 4.22), and the window is
+// solved (window_solver.hpp) with the pivot held fixed.
 // A new frame starts at the window's estimate of the previous frame moved by
-// the odometry's relative motion. When the window is full, the oldest state is
-// marginalized into the linear prior (eq 4.39-4.44, first-estimate Jacobians,
-// marginalization.hpp) and the window shifts: the frame at p moves to p - 1,
-// becomes fixed, its features join the map, and its pose is settled (final).
-//
-// The local map is constant during a solve and lies in the world frame, so
-// each map term touches one pose and the extrinsics are fixed: H is block
-// diagonal and marginalizing the (fixed) oldest state leaves an empty prior.
-// The prior machinery is kept in the loop so that terms coupling poses (the
-// thesis's map in the pivot frame) carry information across shifts.
+// the odometry's relative motion. When the window is full, the pivot is
+// marginalized (sec 4.7.5: "x_p is the only state to be marginalized"; eq
+// 4.39-4.44, first-estimate Jacobians, marginalization.hpp): every map term
+// touches it, so eliminating it leaves a prior on the variable frames' poses
+// relative to each other (rank at most 6 (N - p): a motion common to all
+// poses and the map moves no residual). Then the window shifts: frame 0 leaves, the frame
+// at p moves to p - 1, becomes the new pivot (fixed), its features join the
+// map, and its pose is settled (final); the prior now ties the later frames to it.
 #include <cstddef>
 #include <deque>
 #include <optional>

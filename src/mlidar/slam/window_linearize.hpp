@@ -19,6 +19,11 @@
 // left perturbations of both (tangent [t, r]):
 //   ds/d(pose)      = [n, q x n]                       (dq = [I, -[q]x] d)
 //   ds/d(extrinsic) = [v, y x v],  v = R_world_base^T n (dq = R [I, -[y]x] e)
+// With an anchored map (window_problem.hpp) the plane or line is first moved by
+// D = T_p T0_p^-1 (n' = R_D n, d' = d - n'^T t_D; a' = D a, u' = R_D u) and the
+// rows above use n'; the pivot's gradient is then -ds/d(pose): s = n^T D^-1 q + d
+// and a left perturbation of T_p turns D^-1 q into D^-1 Exp(-e) q. A feature of
+// the pivot itself has zero pose gradient in total (T_p^-1 T_p cancels).
 #include <array>
 
 #include <Eigen/Core>
@@ -40,8 +45,11 @@ struct ResidualRows {
   double squared_norm() const;  ///< |r|^2
 };
 
-ResidualRows plane_rows(const PlaneCorrespondence& c, const SE3& T_world_base, const SE3& T_base_lidar);
-ResidualRows edge_rows(const EdgeCorrespondence& c, const SE3& T_world_base, const SE3& T_base_lidar);
+/// `T_map_motion`: D of an anchored map (map_motion), identity for a world map.
+ResidualRows plane_rows(const PlaneCorrespondence& c, const SE3& T_world_base, const SE3& T_base_lidar,
+                        const SE3& T_map_motion = SE3::identity());
+ResidualRows edge_rows(const EdgeCorrespondence& c, const SE3& T_world_base, const SE3& T_base_lidar,
+                       const SE3& T_map_motion = SE3::identity());
 
 /// Huber loss rho(s) of a squared norm s (see above).
 double huber_loss(double squared_norm, double delta);

@@ -72,12 +72,19 @@ void check_indices(const std::vector<Correspondence>& list, const WindowState& s
 
 }  // namespace
 
+SE3 map_motion(const MapAnchor& anchor, const WindowState& state) {
+  if (anchor.frame < 0) return SE3::identity();
+  return state.T_world_base.at(static_cast<std::size_t>(anchor.frame)) * anchor.T_world_base_reference.inverse();
+}
+
 void check_problem(const WindowProblem& problem, const WindowState& state) {
   require(state.pose_fixed.size() == state.T_world_base.size(), "pose_fixed size differs from the number of poses");
   require(state.extrinsic_fixed.size() == state.T_base_lidar.size(), "extrinsic_fixed size differs from the number of LiDARs");
   require(state.extrinsic_fixed.empty() || state.extrinsic_fixed[0], "the base LiDAR's extrinsic must be fixed");
   check_indices(problem.planes, state, "plane");
   check_indices(problem.edges, state, "edge");
+  require(problem.anchor.frame >= -1 && problem.anchor.frame < static_cast<int>(state.T_world_base.size()),
+          "map anchor " + std::to_string(problem.anchor.frame) + " outside the window");
   const LinearPrior& prior = problem.prior;
   require(prior.linearization_points.size() == prior.variables.size(), "prior linearization points differ from its variables");
   require(prior.jacobian.cols() == static_cast<Eigen::Index>(6 * prior.variables.size()) && prior.jacobian.rows() == prior.residual.size(),

@@ -11,8 +11,16 @@
 // point q = T_world_base_i * T_base_lidar_j * x and is matched to the local
 // map's plane (eq 4.7) or line (eq 4.8), both given in the world frame and held
 // constant while optimizing. Online calibration (eq 4.21) leaves the auxiliary
-// extrinsics variable; pure odometry (eq 4.22) holds them fixed. The map is in
-// the world frame, so it fixes the gauge; holding poses fixed (the thesis holds
+// extrinsics variable; pure odometry (eq 4.22) holds them fixed.
+//
+// The map is either fixed in the world (it then fixes the gauge) or, as in the
+// thesis, attached to a window pose, the pivot p (MapAnchor): a feature of
+// frame i is then matched in the pivot's frame, r(T_world_base_p^-1
+// T_world_base_i T_base_lidar x), so each term couples the pivot and frame i.
+// The planes and lines are stored in world coordinates at the pivot's
+// reference estimate T0_p; at an estimate T_p they move with D = T_p T0_p^-1
+// (equivalently the point goes to D^-1 q), and the pivot's gradient is minus
+// the frame pose's (window_linearize.hpp). Holding poses fixed (the thesis holds
 // x_1..x_p, the frames that built the map) is the caller's choice.
 #include <vector>
 
@@ -79,12 +87,22 @@ struct LinearPrior {
   Eigen::VectorXd residual;               ///< r*: rank
 };
 
+/// Where the map's planes and lines live (see the top of this file).
+struct MapAnchor {
+  int frame = -1;              ///< the window pose the map is attached to (the pivot); -1: fixed in the world
+  SE3 T_world_base_reference;  ///< that pose's estimate when the planes and lines were found (world coordinates)
+};
+
 /// The window's cost terms (eq 4.20): map residuals f_M and the prior r_pri.
 struct WindowProblem {
   std::vector<PlaneCorrespondence> planes;
   std::vector<EdgeCorrespondence> edges;
+  MapAnchor anchor;   ///< of every plane and edge above
   LinearPrior prior;  ///< empty (no variables) when there is none
 };
+
+/// D = T_p T0_p^-1: how far the anchored map moved from where it was found (identity when not anchored).
+SE3 map_motion(const MapAnchor& anchor, const WindowState& state);
 
 /// Column offsets of the variable (non-fixed) blocks in the tangent vector:
 /// poses first (i ascending), then extrinsics; -1 for a fixed block.
