@@ -9,6 +9,7 @@
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
 #include "mlidar/report/run_report.hpp"
+#include "mlidar/sim/lidar_models.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -19,6 +20,7 @@ struct OdometryOptions {
   BagCliOptions bag;
   double period = 0.1;
   std::string times;
+  std::string model;
   std::string lidars;
   int threads = 0;
   double max_base_gaps = pipelines::kDefaultMaxBaseGaps;
@@ -45,6 +47,7 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
   job.bag_options = bag_source_options(options.bag);
   job.period = options.period;
   if (!options.times.empty()) job.times = options.times;
+  if (!options.model.empty()) job.scan_model = sim::lidar_model(options.model);
   job.lidars = split_names(options.lidars);
   job.threads = options.threads;
   job.max_base_gaps = options.max_base_gaps;
@@ -88,6 +91,13 @@ Command register_odometry(CLI::App& app, const CliContext& context) {
                   "in the clouds' natural order")
       ->needs(scans)
       ->excludes(period);
+  std::string model_names;
+  for (const std::string& name : sim::lidar_model_names()) model_names += (model_names.empty() ? "" : ", ") + name;
+  sub->add_option("--model", options->model,
+                  "With --scans: the clouds' LiDAR (" + model_names +
+                      "): rows and ranges from its vertical angles instead of recovered from each cloud")
+      ->needs(scans)
+      ->check(CLI::IsMember(sim::lidar_model_names()));
   sub->add_option("--lidars", options->lidars, "Comma-separated LiDAR names of the dataset (default: all)");
   sub->add_option("--threads", options->threads, "Worker threads (0: all cores)")->check(thread_count())->capture_default_str();
   add_max_base_gaps_option(*sub, options->max_base_gaps);

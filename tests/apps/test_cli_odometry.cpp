@@ -119,6 +119,29 @@ TEST(CliOdometry, ScanFolderOfOneLidarTracksThatLidar) {
   EXPECT_LT(ate_rmse(gt, est), kMaxScanFolderAteM);
 }
 
+TEST(CliOdometry, ScanFolderTakesTheNamedModel) {
+  // `--model NAME`: the clouds' rows from the named LiDAR's vertical angles (rv's top is an RS-LiDAR-16).
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate_drive(dir);
+  const fs::path scans = sim / "scans" / "top";
+  const fs::path run = dir / "run";
+  CliResult result =
+      run_cli("odometry --scans " + quoted(scans.string()) + " --period 0.1 --model RS-LiDAR-16 --out " + quoted(run.string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  read_run_folder(run);
+  const auto metrics = nlohmann::json::parse(std::ifstream(run / "metrics.json"));
+  EXPECT_EQ(metrics["front_end"]["lidar"]["frames_by_source"]["model"].get<int>(), kFrames) << metrics["front_end"].dump();
+  EXPECT_EQ(metrics["per_frame"][0]["front_end"]["lidar"]["rows"].get<int>(), 16);
+  // An unknown model or one without --scans is a usage error naming the known ones; nothing is written.
+  const fs::path bad = dir / "bad";
+  result = run_cli("odometry --scans " + quoted(scans.string()) + " --model OS9-512 --out " + quoted(bad.string()));
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("OS0-64"), std::string::npos) << result.output;
+  result = run_cli("odometry --dataset " + quoted(sim.string()) + " --model VLP-16 --out " + quoted(bad.string()));
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_FALSE(fs::exists(bad));
+}
+
 // `--config` takes the slam config's `selection` section (thesis Ch. 5): the
 // run still tracks the drive, and metrics.json says per frame and per LiDAR
 // how many features were chosen; `slam --config` reports the same. A bad key

@@ -18,7 +18,8 @@ struct Expected {
 
 TEST(LidarModels, TablesMatchDatasheets) {
   const Expected table[] = {{"VLP-16", 16, -15.0, 15.0},      {"HDL-32E", 32, -30.67, 10.67}, {"HDL-64E", 64, -24.8, 2.0},
-                            {"RS-LiDAR-16", 16, -15.0, 15.0}, {"OS1-64", 64, -16.6, 16.6},    {"PandarQT", 64, -52.1, 52.1}};
+                            {"RS-LiDAR-16", 16, -15.0, 15.0}, {"OS1-64", 64, -16.6, 16.6},    {"OS0-64", 64, -45.0, 45.0},
+                            {"PandarQT", 64, -52.1, 52.1}};
   for (const auto& e : table) {
     const LidarModel model = lidar_model(e.name);
     EXPECT_EQ(model.rings(), e.rings) << e.name;

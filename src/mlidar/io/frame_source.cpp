@@ -112,13 +112,13 @@ FrameSource FrameSource::dataset(const std::filesystem::path& folder, std::span<
   return source;
 }
 
-FrameSource FrameSource::scan_folder(const std::filesystem::path& folder, double period,
-                                     const std::optional<std::filesystem::path>& times) {
+FrameSource FrameSource::scan_folder(const std::filesystem::path& folder, double period, const std::optional<std::filesystem::path>& times,
+                                     const LidarModel& model) {
   if (!(period > 0.0) || !std::isfinite(period)) throw UsageError("--period: expected a finite number of seconds > 0");
   FrameSource source;
   source.period_ = period;
   source.own_clock_ = times.has_value();
-  source.lidars_.push_back({"lidar", LidarModel{}, std::nullopt, TimeUnit::kAuto, folder});
+  source.lidars_.push_back({"lidar", model, std::nullopt, TimeUnit::kAuto, folder});
   std::vector<std::vector<std::optional<std::filesystem::path>>> files(1);
   for (const auto& cloud : natural_sorted_clouds(folder)) {
     source.stamps_.push_back(static_cast<double>(source.stamps_.size()) * period);

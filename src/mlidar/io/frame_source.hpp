@@ -94,8 +94,9 @@ class FrameSource {
   /// stamps of `times` (one per cloud in the clouds' natural order, strictly
   /// increasing, as times.txt; its median gap is then the period). InputError
   /// naming `times` when its count differs from the clouds'.
+  /// `model`: the clouds' LiDAR (e.g. from `--model OS1-64`); empty (no rings): the front end recovers rows or uses voxels.
   static FrameSource scan_folder(const std::filesystem::path& folder, double period,
-                                 const std::optional<std::filesystem::path>& times = std::nullopt);
+                                 const std::optional<std::filesystem::path>& times = std::nullopt, const LidarModel& model = {});
   /// A bag's PointCloud2 topics (io/bag_frames.hpp: the frames follow the base LiDAR's scans).
   static FrameSource bag(const std::filesystem::path& path, const BagSourceOptions& options);
 

@@ -20,7 +20,7 @@ io::FrameSource open_source(const OdometryJob& job) {
   const int inputs = (job.dataset.empty() ? 0 : 1) + (job.scans.empty() ? 0 : 1) + (job.bag.empty() ? 0 : 1);
   if (inputs != 1) throw UsageError("give exactly one of --dataset DIR, --scans FOLDER or --bag BAG");
   if (job.dataset.empty() && !job.lidars.empty()) throw UsageError("--lidars applies to --dataset only (with --bag, --topics picks them)");
-  if (!job.scans.empty()) return io::FrameSource::scan_folder(job.scans, job.period, job.times);
+  if (!job.scans.empty()) return io::FrameSource::scan_folder(job.scans, job.period, job.times, job.scan_model);
   if (!job.bag.empty()) return open_frames({}, job.bag, job.bag_options);
   return io::FrameSource::dataset(job.dataset, job.lidars);
 }

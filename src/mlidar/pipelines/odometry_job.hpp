@@ -31,6 +31,7 @@ struct OdometryJob {
   std::filesystem::path scans;                 ///< a folder of clouds, or empty
   double period = 0.1;                         ///< seconds between clouds of `scans`
   std::optional<std::filesystem::path> times;  ///< instead of `period`: one stamp per cloud of `scans`
+  LidarModel scan_model;                       ///< the LiDAR of `scans` (`--model`); empty: rows recovered or voxels
   std::vector<std::string> lidars;             ///< dataset LiDARs to use; empty = all
   int threads = 0;                             ///< 0 = TBB's default
   double max_base_gaps = kDefaultMaxBaseGaps;  ///< share of frames the base LiDAR may lack a usable scan in

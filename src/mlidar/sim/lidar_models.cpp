@@ -41,7 +41,7 @@ LidarModel make(const std::string& name, std::vector<double> angles, double hori
 
 }  // namespace
 
-std::vector<std::string> lidar_model_names() { return {"VLP-16", "HDL-32E", "HDL-64E", "RS-LiDAR-16", "OS1-64", "PandarQT"}; }
+std::vector<std::string> lidar_model_names() { return {"VLP-16", "HDL-32E", "HDL-64E", "RS-LiDAR-16", "OS1-64", "OS0-64", "PandarQT"}; }
 
 LidarModel lidar_model(const std::string& name) {
   // Datasheet figures at 10 Hz: elevation table, azimuth step, range limits, range accuracy (1 sigma).
@@ -50,6 +50,8 @@ LidarModel lidar_model(const std::string& name) {
   if (name == "HDL-64E") return make(name, hdl64_angles(), 0.1728, 1.0, 120.0, 0.02);
   if (name == "RS-LiDAR-16") return make(name, uniform_angles(-15.0, 15.0, 16), 0.2, 0.4, 150.0, 0.03);
   if (name == "OS1-64") return make(name, uniform_angles(-16.6, 16.6, 64), 360.0 / 1024.0, 0.3, 120.0, 0.03);
+  // Ouster OS0-64: 90 deg of uniform beams (the BALM keyframes' Ouster spans -45..45 deg), 1024 columns.
+  if (name == "OS0-64") return make(name, uniform_angles(-45.0, 45.0, 64), 360.0 / 1024.0, 0.3, 100.0, 0.03);
   // Hesai PandarQT-like: 64 beams over a wide field of view, 600 columns, short range.
   if (name == "PandarQT") return make(name, uniform_angles(-52.1, 52.1, 64), 0.6, 0.1, 30.0, 0.03);
   std::string known;

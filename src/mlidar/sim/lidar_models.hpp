@@ -10,7 +10,7 @@
 namespace mlidar::sim {
 
 /// Names accepted by lidar_model(): "VLP-16", "HDL-32E", "HDL-64E",
-/// "RS-LiDAR-16", "OS1-64", "PandarQT".
+/// "RS-LiDAR-16", "OS1-64", "OS0-64", "PandarQT".
 std::vector<std::string> lidar_model_names();
 
 /// The named model; throws UsageError listing the known names otherwise.
