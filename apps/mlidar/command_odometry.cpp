@@ -104,9 +104,9 @@ Command register_odometry(CLI::App& app, const CliContext& context) {
   sub->add_option("--config", options->config,
                   "Registration parameters: the `odometry` and `selection` sections of the YAML that `slam --config` reads "
                   "(config/mloam.yaml documents every key)");
-  sub->add_option(
-         "--out", options->out,
-         "Run folder: trajectory.tum, trajectory.kitti, map.ply, metrics.json, run.json (a new or empty folder, or an earlier run)")
+  sub->add_option("--out", options->out,
+                  "Run folder: trajectory.tum, trajectory.kitti, pose_covariance.txt, map.ply, metrics.json, run.json (a new or empty "
+                  "folder, or an earlier run)")
       ->required();
   add_overwrite_flag(*sub, options->overwrite);
   return {sub, [options, &context] { return run_odometry(*options, context); }};

@@ -39,7 +39,9 @@ void print_lidar(const pipelines::SlamLidarReport& lidar) {
     const pipelines::AppearanceAttempt& last = lidar.appearance_attempts.back();
     std::cout << "    appearance start at frame " << last.frame << " (" << lidar.appearance_attempts.size() << " attempt(s), "
               << last.frames_used << " frames, " << (last.searched ? "with" : "without") << " search): " << last.verdict << ", "
-              << last.message << "; tried again every initialization.appearance_after_frames frames; else `--calibrate refine` from the dataset's extrinsics, or `mlidar calibrate auto` over the whole drive\n";
+              << last.message
+              << "; tried again every initialization.appearance_after_frames frames; else `--calibrate refine` from the dataset's "
+                 "extrinsics, or `mlidar calibrate auto` over the whole drive\n";
   }
   if (lidar.restarts == 0 && !lidar.reinitialization_frames.empty())
     std::cout << "    re-initialized " << lidar.reinitialization_frames.size()
@@ -69,8 +71,9 @@ pipelines::ExtrinsicSource extrinsic_source(const std::string& name) {
 }
 
 int run_slam(SlamOptions options, const CliContext& context) {
-  io::RunFolder run(options.job.out, "slam",
-                    context.run_folder(options.overwrite, {options.job.dataset.empty() ? std::filesystem::path(options.bag.bag) : options.job.dataset}));
+  io::RunFolder run(
+      options.job.out, "slam",
+      context.run_folder(options.overwrite, {options.job.dataset.empty() ? std::filesystem::path(options.bag.bag) : options.job.dataset}));
   pipelines::SlamJob job = options.job;
   job.bag = options.bag.bag;
   job.bag_options = bag_source_options(options.bag);
@@ -109,7 +112,8 @@ Command register_slam(CLI::App& app, const CliContext& context) {
   sub->add_option("--threads", job->threads, "Worker threads (0: all cores)")->check(thread_count())->capture_default_str();
   add_max_base_gaps_option(*sub, job->max_base_gaps);
   sub->add_option("--out", job->out,
-                  "Run folder: trajectory.tum/.kitti, extrinsics.yaml, map.ply, metrics.json, report.html, run.json (a new or empty folder, or an "
+                  "Run folder: trajectory.tum/.kitti, pose_covariance.txt, extrinsics.yaml, map.ply, metrics.json, report.html, run.json "
+                  "(a new or empty folder, or an "
                   "earlier run)")
       ->required();
   add_overwrite_flag(*sub, options->overwrite);

@@ -10,12 +10,14 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_runner.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "test_support.hpp"
 
@@ -44,6 +46,17 @@ Trajectory read_run_folder(const fs::path& run) {
   EXPECT_GT(map.table.num_points, 1000U);
   const auto metrics = nlohmann::json::parse(std::ifstream(run / "metrics.json"));
   EXPECT_EQ(metrics["frames"].get<int>(), kFrames);
+  // One covariance per frame, at the trajectory's stamps: zero at the first frame, then positive definite.
+  const auto covariances = io::read_pose_covariances(run / "pose_covariance.txt");
+  EXPECT_EQ(covariances.size(), tum.poses.size());
+  for (std::size_t k = 0; k < std::min(covariances.size(), tum.poses.size()); ++k) {
+    EXPECT_EQ(covariances[k].stamp, tum.poses[k].stamp);
+    if (k == 0) {
+      EXPECT_EQ(covariances[k].covariance.norm(), 0.0);
+    } else {
+      EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6>(covariances[k].covariance).eigenvalues().minCoeff(), 0.0) << k;
+    }
+  }
   EXPECT_EQ(metrics["lost_frames"].get<int>(), 0);
   EXPECT_EQ(metrics["per_frame"].size(), static_cast<std::size_t>(kFrames));
   return tum;
@@ -100,6 +113,22 @@ TEST(CliOdometry, DegenerateFramesNameTheirUnobservableDirection) {
     EXPECT_EQ(frame["weak_direction"], "x (forward-backward)");
     EXPECT_GT(std::abs(frame["weak_translation_base"][0].get<double>()), 0.95);
   }
+  // The pose covariance grows along the corridor's axis (the base's x is the world's here), far beyond the
+  // measured directions, and covers the true error there (the motion along the axis is never measured).
+  const auto covariances = io::read_pose_covariances(run / "pose_covariance.txt");
+  ASSERT_EQ(covariances.size(), static_cast<std::size_t>(kFrames));
+  const Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");
+  const Trajectory est = io::read_tum(run / "trajectory.tum");
+  double previous = 0.0;
+  for (std::size_t k = 1; k < covariances.size(); ++k) {
+    const Mat6& c = covariances[k].covariance;
+    EXPECT_GT(c(0, 0), previous) << k;
+    previous = c(0, 0);
+    EXPECT_GT(c(0, 0), 20.0 * std::max(c(1, 1), c(2, 2))) << k;
+    EXPECT_NEAR(metrics["per_frame"][k]["pose_covariance_trace"].get<double>(), c.trace(), 1e-12 * c.trace());
+  }
+  const double error_x = (gt.poses.back().T_world_base.translation() - est.poses.back().T_world_base.translation()).x();
+  EXPECT_LT(std::abs(error_x), 3.0 * std::sqrt(covariances.back().covariance(0, 0))) << error_x;
 }
 
 TEST(CliOdometry, ScanFolderOfOneLidarTracksThatLidar) {

@@ -23,6 +23,7 @@
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/dataset.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "test_support.hpp"
 
@@ -63,7 +64,8 @@ void expect_documented_keys(const nlohmann::json& metrics, int frames) {
     for (const char* stat : {"mean", "p50", "p95", "max"}) EXPECT_TRUE(metrics["stages"][stage].contains(stat)) << stage << " " << stat;
   ASSERT_EQ(metrics["per_frame"].size(), static_cast<std::size_t>(frames));
   const auto& frame = metrics["per_frame"].back();
-  for (const char* key : {"stamp", "mode", "lost", "trusted_changed", "lidars"}) EXPECT_TRUE(frame.contains(key)) << key;
+  for (const char* key : {"stamp", "mode", "lost", "trusted_changed", "lidars", "pose_covariance_trace"})
+    EXPECT_TRUE(frame.contains(key)) << key;
   for (const char* key : {"role", "scan_missing", "lambda_min", "accepted", "window_estimate", "mean_residual_m", "shock",
                           "window_information", "window_residual_variance_m2", "reinitialized"})
     EXPECT_TRUE(frame["lidars"]["right"].contains(key)) << key;
@@ -93,6 +95,19 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   EXPECT_EQ(io::read_kitti_poses(run / "trajectory.kitti").poses.size(), static_cast<std::size_t>(kFrames));
   EXPECT_LT(ate_rmse(io::read_tum(sim / "groundtruth" / "trajectory.tum"), est), kMaxAteM);
   EXPECT_GT(io::read_cloud(run / "map.ply").table.num_points, 1000U);
+  // One pose covariance per written pose, from zero at the first frame; its rotation block (a local tangent:
+  // its trace does not depend on the pose) grows frame by frame.
+  const auto covariances = io::read_pose_covariances(run / "pose_covariance.txt");
+  ASSERT_EQ(covariances.size(), est.poses.size());
+  EXPECT_EQ(covariances.front().covariance.norm(), 0.0);
+  for (std::size_t k = 1; k < covariances.size(); ++k) {
+    EXPECT_EQ(covariances[k].stamp, est.poses[k].stamp);
+    const Mat6& now = covariances[k].covariance;
+    const Mat6& before = covariances[k - 1].covariance;
+    const double rotation_now = now.bottomRightCorner(3, 3).trace();
+    EXPECT_GT(rotation_now, before.bottomRightCorner(3, 3).trace()) << k;
+    EXPECT_GT(now.topLeftCorner(3, 3).diagonal().minCoeff(), 0.0) << k;
+  }
 
   const auto metrics = read_metrics(run);
   expect_documented_keys(metrics, kFrames);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "format_test_util.hpp"
+#include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "pose_error.hpp"
 #include "test_support.hpp"
@@ -52,6 +53,31 @@ TEST(TrajectoryRoundTrip, TumAndKittiWithin1e12) {
   expect_close(trajectory, read_kitti_poses(dir / "t.kitti", stamps), 1e-12, true);
   const Trajectory indexed = read_kitti_poses(dir / "t.kitti");
   EXPECT_EQ(indexed.poses[7].stamp, 7.0);
+}
+
+TEST(PoseCovarianceFile, RoundTripsTheUpperTriangleExactly) {
+  const auto dir = test::scratch_dir();
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<StampedCovariance> written;
+  for (int k = 0; k < 5; ++k) {
+    const Mat6 A = Mat6::NullaryExpr([&] { return normal(rng); });
+    written.push_back({0.1 * k + 1e9, A * A.transpose() * 1e-4});
+  }
+  write_pose_covariances(dir / "pose_covariance.txt", written);
+  const std::vector<StampedCovariance> read = read_pose_covariances(dir / "pose_covariance.txt");
+  ASSERT_EQ(read.size(), written.size());
+  for (std::size_t k = 0; k < read.size(); ++k) {
+    EXPECT_EQ(read[k].stamp, written[k].stamp);
+    EXPECT_EQ(read[k].covariance, written[k].covariance) << k;  // exact digits, symmetric
+  }
+}
+
+TEST(PoseCovarianceFile, ABadLineNamesTheFileAndLine) {
+  expect_input_error([] { parse_pose_covariances("# header\n1 2 3\n", "pc.txt"); }, {"pc.txt", "line 2", "expected 22 values"});
+  std::string nan_line = "1";
+  for (int k = 0; k < 21; ++k) nan_line += k == 4 ? " nan" : " 0";
+  expect_input_error([&] { parse_pose_covariances(nan_line + "\n", "pc.txt"); }, {"pc.txt", "line 1", "finite"});
 }
 
 TEST(TumReader, SkipsCommentsAndNormalisesSixDigitQuaternions) {

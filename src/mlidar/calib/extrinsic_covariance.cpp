@@ -5,6 +5,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "mlidar/core/covariance.hpp"
+
 namespace mlidar::calib {
 namespace {
 
@@ -52,11 +54,7 @@ double integrated_autocorrelation_time(std::span<const Vec6> deviations) {
 }
 
 Mat6 local_covariance_from_left_information(const SE3& T, const Mat6& information, double residual_variance) {
-  // Exp(d) T = (Exp(phi) R, Exp(phi) t + J_l rho) ~ (R Exp(R^T phi), t + rho - [t]x phi).
-  Mat6 M = Mat6::Zero();
-  M.topLeftCorner<3, 3>().setIdentity();
-  M.topRightCorner<3, 3>() = -hat(T.translation());
-  M.bottomRightCorner<3, 3>() = T.rotation().toRotationMatrix().transpose();
+  const Mat6 M = left_to_local_tangent(T);
   return M * (residual_variance * pseudo_inverse(information)) * M.transpose();
 }
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "mlidar/core/se3.hpp"
 #include "mlidar/core/so3.hpp"
 
 namespace mlidar {
@@ -12,6 +13,17 @@ namespace mlidar {
 /// The largest 1-sigma of a 3x3 covariance block: sqrt of its largest eigenvalue (0 for a negative one).
 inline double largest_sd(const Mat3& block) {
   return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat3>(block).eigenvalues()(2)));
+}
+
+/// M with e = M d: a left perturbation Exp(d) T, d = [rho, phi] (world frame), in the [t additive, r local]
+/// tangent of extrinsics.yaml and pose_covariance.txt, T = (R Exp(r), t + dt), to first order:
+/// Exp(d) T ~ (R Exp(R^T phi), t + rho - [t]x phi), so M = [I, -[t]x; 0, R^T]. Covariances map as M C M^T.
+inline Mat6 left_to_local_tangent(const SE3& T) {
+  Mat6 M = Mat6::Zero();
+  M.topLeftCorner<3, 3>().setIdentity();
+  M.topRightCorner<3, 3>() = -hat(T.translation());
+  M.bottomRightCorner<3, 3>() = T.rotation_matrix().transpose();
+  return M;
 }
 
 }  // namespace mlidar

@@ -110,7 +110,10 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
   write_map_ply(job.out / "map.ply", odometry);
+  const std::vector<io::StampedCovariance> covariances = pose_covariances(results);
+  io::write_pose_covariances(job.out / "pose_covariance.txt", covariances);
   nlohmann::json metrics = odometry_metrics_json(results, lidars);
+  add_pose_covariance_traces(metrics, covariances);
   metrics["skipped_scans"] = gaps.json();
   const std::string text = metrics.dump(2);
   io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << text << '\n'; });

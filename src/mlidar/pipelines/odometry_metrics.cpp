@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mlidar/core/covariance.hpp"
 #include "mlidar/io/cloud_file.hpp"
+#include "mlidar/slam/pose_covariance.hpp"
 
 namespace mlidar::pipelines {
 nlohmann::json timing_summary(std::vector<double> values) {
@@ -64,6 +66,23 @@ nlohmann::json front_end_summary(const std::vector<std::string>& names, const st
 }
 
 }  // namespace
+
+std::vector<io::StampedCovariance> pose_covariances(const std::vector<slam::FrameResult>& frames) {
+  slam::PoseCovarianceChain chain;
+  std::vector<io::StampedCovariance> out;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const Mat6& left = chain.add(frames[k], k == 0);
+    const Mat6 M = left_to_local_tangent(frames[k].T_world_base);
+    out.push_back({frames[k].stamp, M * left * M.transpose()});
+  }
+  return out;
+}
+
+void add_pose_covariance_traces(nlohmann::json& metrics, const std::vector<io::StampedCovariance>& covariances) {
+  nlohmann::json& per_frame = metrics["per_frame"];
+  for (std::size_t k = 0; k < covariances.size() && k < per_frame.size(); ++k)
+    per_frame[k]["pose_covariance_trace"] = covariances[k].covariance.trace();
+}
 
 FrontEndTally front_end_tally(const std::vector<slam::FrameResult>& frames, std::size_t lidar) {
   FrontEndTally tally;

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/slam/odometry.hpp"
 
 namespace mlidar::pipelines {
@@ -16,6 +17,13 @@ namespace mlidar::pipelines {
 /// {"frames", "lidars", "stages": {NAME: {mean, p50, p95, max} seconds per frame},
 ///  "total_seconds": {...}, "points_in", "features_out", "degenerate_frames", "retried_frames",
 ///  "lost_frames", "per_frame": [{stamp, eigenvalues, translation_observability, degenerate, lost, ..., selection}]}
+/// Each frame's pose covariance (slam/pose_covariance.hpp, accumulated from the first frame) in
+/// pose_covariance.txt's tangent, at the frame's stamp.
+std::vector<io::StampedCovariance> pose_covariances(const std::vector<slam::FrameResult>& frames);
+
+/// metrics.json per frame: `pose_covariance_trace` (m^2 + rad^2) from `covariances` (one per frame).
+void add_pose_covariance_traces(nlohmann::json& metrics, const std::vector<io::StampedCovariance>& covariances);
+
 nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frames, const std::vector<slam::LidarSetup>& lidars);
 
 /// A frame's feature selection (null when off): {method, features, searched, matched, budget, selected,

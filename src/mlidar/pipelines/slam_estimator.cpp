@@ -113,6 +113,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   out.lost = last_odometry_.lost();
   out.suspect = last_odometry_.suspect();
   out.T_world_base = last_odometry_.T_world_base;
+  out.pose_covariance = pose_covariance_.add(last_odometry_, k == 0);
   out.selection = last_odometry_.selection_summary();
   if (out.selection)
     for (const slam::LidarSetup& lidar : odometry_->lidars()) out.selection_lidars.push_back(lidar.name);

@@ -34,6 +34,7 @@
 #include "mlidar/pipelines/slam_pose_window.hpp"
 #include "mlidar/pipelines/slam_types.hpp"
 #include "mlidar/slam/odometry.hpp"
+#include "mlidar/slam/pose_covariance.hpp"
 
 namespace mlidar::pipelines {
 
@@ -74,6 +75,7 @@ class SlamEstimator {
   std::unique_ptr<slam::Odometry> odometry_;  ///< over the trusted LiDARs
   std::vector<std::size_t> trusted_;          ///< indices in odometry_'s LiDAR order
   slam::FrameResult last_odometry_;
+  slam::PoseCovarianceChain pose_covariance_;
   std::optional<SlamPoseWindow> pose_window_;  ///< window.refine_odometry
   AppearanceHistory history_;                  ///< the last appearance_after_frames + 1 frames while some LiDAR initializes
   bool trusted_changed_ = false;

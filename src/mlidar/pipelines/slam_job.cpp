@@ -6,6 +6,7 @@
 
 #include <tbb/global_control.h>
 
+#include "mlidar/core/covariance.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/dataset.hpp"
@@ -93,6 +94,19 @@ Trajectory final_trajectory(const SlamRun& run, const BaseFrame& frame) {
   return trajectory;
 }
 
+/// Each frame's pose covariance in pose_covariance.txt's tangent at the written pose: the left perturbation
+/// taken to the output base (T_w_B = C T_w_R C^-1 moves Exp(d) by Ad(C)), then to [t additive, r local].
+std::vector<io::StampedCovariance> pose_covariances(const SlamRun& run, const BaseFrame& frame, const Trajectory& trajectory) {
+  const Mat6 to_base = frame.is_reference ? Mat6(Mat6::Identity()) : frame.T_base_reference.adjoint();
+  std::vector<io::StampedCovariance> out;
+  for (std::size_t k = 0; k < run.frames.size(); ++k) {
+    const Mat6 left = to_base * run.frames[k].pose_covariance * to_base.transpose();
+    const Mat6 M = left_to_local_tangent(trajectory.poses[k].T_world_base);
+    out.push_back({trajectory.poses[k].stamp, M * left * M.transpose()});
+  }
+  return out;
+}
+
 SlamJobSummary summarize(const SlamRun& run, const SlamEstimator& estimator, const std::vector<std::size_t>& order, const FrameGaps& gaps,
                          const SlamJob& job, const BaseFrame& frame) {
   SlamJobSummary summary;
@@ -137,11 +151,14 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
   std::filesystem::create_directories(job.out);
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
+  const std::vector<io::StampedCovariance> covariances = pose_covariances(run, frame, summary.trajectory);
+  io::write_pose_covariances(job.out / "pose_covariance.txt", covariances);
   write_extrinsics_file(job.out / "extrinsics.yaml", frame, summary.lidars);
   std::vector<Eigen::Vector3f> map = estimator.map_points();
   for (Eigen::Vector3f& p : map) p = frame.point_to_base(p);
   write_map_ply(job.out / "map.ply", std::move(map));
   nlohmann::json metrics = slam_metrics_json(run.frames, order, summary.lidars, run.load_seconds, to_string(job.calibrate));
+  add_pose_covariance_traces(metrics, covariances);
   metrics["skipped_scans"] = gaps.json();
   metrics["convergence"] = {{"lambda_calib", config.convergence.lambda_calib}, {"accepted_needed", config.convergence.accepted_needed}};
   const std::string text = metrics.dump(2);

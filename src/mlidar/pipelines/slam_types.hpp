@@ -62,7 +62,9 @@ struct SlamFrame {
   bool calibrating = false;                 ///< some LiDAR not trusted after this frame (online-calibration mode), else pure odometry
   bool lost = false;                        ///< the trusted odometry could not register this frame
   bool suspect = false;                     ///< its registration was doubtful (slam::FrameResult::suspect)
-  bool trusted_changed = false;             ///< the trusted set changes from the next frame on
+  /// The trusted odometry's pose covariance (slam/pose_covariance.hpp; left perturbation, world frame).
+  Mat6 pose_covariance = Mat6::Zero();
+  bool trusted_changed = false;  ///< the trusted set changes from the next frame on
   std::vector<SlamLidarFrame> lidars;
   SlamStageSeconds seconds;
   /// The trusted odometry's feature selection (none when off), for the LiDARs it registered (selection_lidars).
