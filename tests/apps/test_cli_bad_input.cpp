@@ -246,12 +246,38 @@ std::string finding(const std::string& output, const std::string& check) {
   return output.substr(start, output.find('\n', at) - start);
 }
 
+TEST(CliDoctor, SaysWhetherTheMotionIsEnoughForHandEye) {
+  // The base's own odometry: a rig that stands still does not turn; a ground vehicle turns about its z only.
+  const fs::path dir = scratch_dir();
+  ASSERT_EQ(
+      run_cli("simulate drive --rig rhd --scene room --trajectory static --frames 8 --seed 1 --out " + quoted((dir / "static").string()))
+          .exit_code,
+      0);
+  const CliResult still = run_cli("doctor " + quoted((dir / "static").string()));
+  EXPECT_EQ(still.exit_code, 0) << "a warning, not a failure: odometry needs no turns\n" << still.output;
+  const std::string still_motion = finding(still.output, "motion left");
+  EXPECT_EQ(still_motion.rfind("warning", 0), 0u) << still.output;
+  EXPECT_NE(still_motion.find("needs turns"), std::string::npos) << still.output;
+  EXPECT_NE(still_motion.find("--calibrate refine or fixed"), std::string::npos) << still.output;
+
+  ASSERT_EQ(run_cli("simulate drive --rig single-vlp16 --scene campus --trajectory vehicle --frames 60 --seed 1 --out " +
+                    quoted((dir / "vehicle").string()))
+                .exit_code,
+            0);
+  const CliResult vehicle = run_cli("doctor " + quoted((dir / "vehicle").string()));
+  EXPECT_EQ(vehicle.exit_code, 0) << vehicle.output;
+  const std::string planar = finding(vehicle.output, "motion lidar");
+  EXPECT_EQ(planar.rfind("warning", 0), 0u) << vehicle.output;
+  EXPECT_NE(planar.find("every turn is about the base's z (up-down) (planar motion)"), std::string::npos) << vehicle.output;
+}
+
 TEST(CliDoctor, NamesWhatWouldMisleadARunWithItsFixAndExitsOneOnlyForFailures) {
   const fs::path dir = scratch_dir();
   CliResult clean = run_cli("doctor " + quoted(small_dataset().string()) + " --json " + quoted((dir / "clean.json").string()));
   EXPECT_EQ(clean.exit_code, 0) << clean.output;
   EXPECT_EQ(clean.output.find("warning"), std::string::npos) << clean.output;
   EXPECT_NE(finding(clean.output, "overlap right").rfind("ok", 0), std::string::npos) << clean.output;
+  EXPECT_NE(finding(clean.output, "motion left").find("enough for hand-eye"), std::string::npos) << clean.output;  // handheld
   const nlohmann::json json = nlohmann::json::parse(std::ifstream(dir / "clean.json"));
   EXPECT_FALSE(json["failed"].get<bool>());
   EXPECT_GE(json["findings"].size(), 8u);

@@ -11,7 +11,9 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/core/median.hpp"
 #include "mlidar/geometry/kdtree.hpp"
+#include "mlidar/pipelines/doctor_motion.hpp"
 #include "mlidar/pipelines/frame_gaps.hpp"
+#include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/slam/row_recovery.hpp"
 
 namespace mlidar::pipelines {
@@ -79,8 +81,10 @@ void tally_scan(const Scan& scan, LidarTally& t) {
   }
 }
 
-/// Reads every frame; a frame the jobs would reject is a failure naming it.
-std::vector<LidarTally> read_all(const io::FrameSource& source, const DoctorConfig& config, std::vector<Finding>& out) {
+/// Reads every frame; a frame the jobs would reject is a failure naming it. The base's scans also go to `motion`.
+std::vector<LidarTally> read_all(const io::FrameSource& source, const DoctorConfig& config, std::optional<BaseMotion>& motion,
+                                 std::vector<Finding>& out) {
+  const std::optional<std::size_t> base = source.reference_index();
   std::vector<LidarTally> tallies(source.lidars().size());
   std::vector<std::string> rejected;
   std::size_t rejected_frames = 0;
@@ -90,6 +94,7 @@ std::vector<LidarTally> read_all(const io::FrameSource& source, const DoctorConf
       for (std::size_t j = 0; j < frame.scans.size(); ++j)
         if (frame.scans[j]) tally_scan(*frame.scans[j], tallies[j]);
       for (const io::SkippedScan& s : frame.skipped) tallies[s.lidar].skipped[io::to_string(s.reason)].push_back(k);
+      if (motion && base) motion->add(frame.stamp, frame.scans[*base]);
     } catch (const std::exception& error) {  // InputError naming the file and field, as the jobs would stop with
       if (rejected.size() < config.max_listed) rejected.push_back("frame " + std::to_string(k) + ": " + error.what());
       ++rejected_frames;
@@ -248,6 +253,42 @@ void check_overlap(const io::FrameSource& source, std::vector<LidarTally>& talli
   }
 }
 
+void check_motion(const io::FrameSource& source, const std::optional<BaseMotion>& motion, const DoctorConfig& config,
+                  std::vector<Finding>& out) {
+  const std::optional<std::size_t> base = source.reference_index();
+  if (!motion || !base) return;
+  const std::string& name = source.lidars()[*base].name;
+  const MotionSummary m = motion->summary(source.period(), config.motion);
+  const std::string gap = number(config.motion.pair_seconds) + " s";
+  if (m.registered * 2 < m.frames) {
+    out.push_back({"motion", name, Severity::kWarning,
+                   "the base's own odometry registered " + std::to_string(m.registered) + " of " + std::to_string(m.frames) +
+                       " frames, so its motion is unknown here: check its scans and model (see above), or give extrinsics and run "
+                       "--calibrate refine or fixed"});
+    return;
+  }
+  if (m.turning_pairs < config.motion.min_turning_pairs) {
+    out.push_back({"motion", name, Severity::kWarning,
+                   "the base turns at most " + number(m.largest_turn_deg, "%.2g") + " deg in " + gap + " (" +
+                       std::to_string(m.turning_pairs) + " of " + std::to_string(m.pairs) + " frame pairs turn " +
+                       number(config.motion.turn_deg) +
+                       " deg or more): hand-eye calibration (slam --calibrate online, calibrate "
+                       "auto) needs turns, about two axes for all six degrees; record with turns, or give extrinsics and run "
+                       "--calibrate refine or fixed"});
+    return;
+  }
+  const std::string seen = std::to_string(m.turning_pairs) + " of " + std::to_string(m.pairs) + " frame pairs " + gap +
+                           " apart turn (up to " + number(m.largest_turn_deg, "%.2g") + " deg), second axis " +
+                           number(100 * m.axis_spread, "%.0f") + " % of the first";
+  if (m.axis_spread < config.motion.min_axis_spread)
+    out.push_back({"motion", name, Severity::kWarning,
+                   seen + ": every turn is about the base's " + base_axis_words(m.main_axis) +
+                       " (planar motion), so hand-eye cannot see the translation along it; slam then takes it from the "
+                       "ground planes. Tilt or rock the rig for a full hand-eye, or give extrinsics (--calibrate refine)"});
+  else
+    out.push_back({"motion", name, Severity::kOk, seen + ": enough for hand-eye"});
+}
+
 }  // namespace
 
 const char* to_string(Severity severity) {
@@ -265,11 +306,19 @@ const char* to_string(Severity severity) {
 std::vector<Finding> examine(const io::FrameSource& source, const DoctorConfig& config) {
   std::vector<Finding> out;
   check_stamps(source, config, out);
-  std::vector<LidarTally> tallies = read_all(source, config, out);
+  std::optional<BaseMotion> motion;
+  if (const std::optional<std::size_t> base = source.reference_index(); base && config.check_motion) {
+    try {
+      motion.emplace(source.lidars()[*base]);
+    } catch (const std::exception&) {  // a model the odometry cannot take: the rings check names it
+    }
+  }
+  std::vector<LidarTally> tallies = read_all(source, config, motion, out);
   check_scans(source, tallies, config, out);
   check_times_and_rings(source, tallies, config, out);
   check_extrinsics(source, config, out);
   check_overlap(source, tallies, config, out);
+  check_motion(source, motion, config, out);
   return out;
 }
 

@@ -6,12 +6,14 @@
 // the same message; then it looks at what reads fine but would mislead a run:
 // gaps in the stamps, scans skipped, per-point times that cover too little of
 // a sweep, rings that do not match the model, extrinsics that are missing or
-// implausible, LiDARs that hardly overlap the base at their given extrinsic.
+// implausible, LiDARs that hardly overlap the base at their given extrinsic,
+// and whether the base turns enough, about enough axes, for hand-eye (doctor_motion.hpp).
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "mlidar/io/frame_source.hpp"
+#include "mlidar/pipelines/doctor_motion.hpp"
 
 namespace mlidar::pipelines {
 
@@ -19,7 +21,7 @@ enum class Severity : std::uint8_t { kOk, kWarning, kFailure };
 const char* to_string(Severity severity);  ///< "ok", "warning", "failure"
 
 struct Finding {
-  std::string check;  ///< "open", "stamps", "scans", "time", "rings", "extrinsics", "overlap"
+  std::string check;  ///< "open", "stamps", "scans", "time", "rings", "extrinsics", "overlap", "motion"
   std::string lidar;  ///< empty when the check is not about one LiDAR
   Severity severity = Severity::kOk;
   std::string message;  ///< what was seen and, unless ok, what to do
@@ -32,6 +34,8 @@ struct DoctorConfig {
   double overlap_radius_m = 0.5;    ///< a point overlaps when a base point lies this close
   double min_overlap = 0.05;        ///< below this share of a LiDAR's points the overlap is too small
   std::size_t max_listed = 5;       ///< frames named in one message
+  bool check_motion = true;         ///< run the base's odometry for the motion check
+  MotionCheckConfig motion;
 };
 
 /// The findings for `source`, every check in the order above. Never throws for
