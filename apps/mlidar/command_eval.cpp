@@ -13,6 +13,7 @@
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 
 namespace mlidar::cli {
@@ -28,6 +29,7 @@ struct TrajOptions {
   std::string delta_unit = "frames";
   std::string json_out;
   std::string plot_out;
+  std::string covariance;  ///< RUN/pose_covariance.txt: report the poses' NEES
 };
 
 struct CalibOptions {
@@ -77,7 +79,16 @@ int run_traj(const TrajOptions& options) {
   const Trajectory est = read_trajectory(options.est, kitti);
   const eval::TrajectoryReport report = eval::evaluate_trajectory(gt, est, eval_options, options.gt, options.est);
   std::cout << eval::format_table(report);
-  write_json(options.json_out, eval::to_json(report));
+  nlohmann::json json = eval::to_json(report);
+  if (!options.covariance.empty()) {
+    const std::vector<io::StampedCovariance> covariances = io::read_pose_covariances(options.covariance);
+    std::vector<double> est_stamps;
+    for (const StampedPose& pose : est.poses) est_stamps.push_back(pose.stamp);
+    const eval::PoseNees nees = eval::evaluate_pose_nees(report, covariances, options.covariance, est_stamps);
+    std::cout << eval::format_table(nees);
+    json["pose_nees"] = eval::to_json(nees);
+  }
+  write_json(options.json_out, json);
   if (!options.plot_out.empty()) {
     const std::string svg = eval::trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
     io::write_atomically(options.plot_out, [&](std::ostream& out) { out << svg; });
@@ -124,6 +135,8 @@ void add_traj(CLI::App& eval_app, std::shared_ptr<TrajOptions> options) {
       ->capture_default_str();
   sub->add_option("--json", options->json_out, "Write the metrics as JSON to this file");
   sub->add_option("--plot", options->plot_out, "Write an SVG plot (top view and ATE over time) to this file");
+  sub->add_option("--covariance", options->covariance,
+                  "The run's pose_covariance.txt: also report the poses' NEES against the ground truth (aligned at the first pose)");
 }
 
 void add_calib(CLI::App& eval_app, std::shared_ptr<CalibOptions> options) {

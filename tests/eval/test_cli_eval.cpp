@@ -59,6 +59,40 @@ TEST(CliEval, TrajectoryOffsetGivesKnownAteAndAlignsAway) {
   EXPECT_EQ(first_line.rfind("<svg", 0), 0U);
 }
 
+TEST(CliEval, PoseCovariancesGetTheirNees) {
+  // A constant offset is gone after the start alignment: zero error, every frame below the band.
+  const fs::path dir = scratch_dir();
+  write_text(dir / "gt.tum", tum_text(20));
+  write_text(dir / "est.tum", tum_text(20, 0.25));
+  std::string covariances = "# stamp, upper triangle\n";
+  char line[64];
+  for (int i = 0; i < 20; ++i) {
+    std::snprintf(line, sizeof(line), "%.6f", 10.0 + 0.1 * i);
+    covariances += line;
+    for (int row = 0; row < 6; ++row)
+      for (int col = row; col < 6; ++col) covariances += row == col && i > 0 ? " 0.01" : " 0";
+    covariances += "\n";
+  }
+  write_text(dir / "pose_covariance.txt", covariances);
+  const std::string files = " --gt " + quoted((dir / "gt.tum").string()) + " --est " + quoted((dir / "est.tum").string());
+  CliResult result = run_cli("eval traj" + files + " --covariance " + quoted((dir / "pose_covariance.txt").string()) + " --json " +
+                             quoted((dir / "nees.json").string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("pose NEES (6 dof, aligned at the first pose): 0.0 % of 19 frames inside"), std::string::npos)
+      << result.output;
+  const auto json = read_json(dir / "nees.json");
+  EXPECT_EQ(json["pose_nees"]["pose"]["frames"].get<int>(), 19);
+  EXPECT_EQ(json["pose_nees"]["skipped"].get<int>(), 1);
+  EXPECT_DOUBLE_EQ(json["pose_nees"]["pose"]["below"].get<double>(), 1.0);
+  EXPECT_EQ(json["pose_nees"]["values"].size(), 19u);
+
+  write_text(dir / "short.txt", "10 1 2 3\n");
+  result = run_cli("eval traj" + files + " --covariance " + quoted((dir / "short.txt").string()));
+  EXPECT_EQ(result.exit_code, 3) << result.output;
+  EXPECT_NE(result.output.find((dir / "short.txt").string()), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("expected 22 values"), std::string::npos) << result.output;
+}
+
 TEST(CliEval, BadTrajectoriesExitThree) {
   const fs::path dir = scratch_dir();
   write_text(dir / "gt.tum", tum_text(20));

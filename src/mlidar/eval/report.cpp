@@ -129,4 +129,34 @@ std::string format_table(const MapMetrics& metrics, const MapMetricsOptions& opt
          "mean plane variance: " + fixed(metrics.mean_plane_variance, 8) + " m^2\n";
 }
 
+namespace {
+
+nlohmann::json band_json(const NeesBand& band) {
+  return {{"frames", band.frames}, {"median", band.median}, {"inside", band.inside},
+          {"below", band.below},   {"above", band.above},   {"band_95", {band.low, band.high}}};
+}
+
+std::string band_line(const char* what, const NeesBand& band) {
+  return std::string(what) + ": " + fixed(100 * band.inside, 1) + " % of " + std::to_string(band.frames) +
+         " frames inside the 95 % band [" + fixed(band.low, 2) + ", " + fixed(band.high, 2) + "] (" + fixed(100 * band.below, 1) +
+         " % below: covariance too large; " + fixed(100 * band.above, 1) + " % above: too small), median " + fixed(band.median, 2) + "\n";
+}
+
+}  // namespace
+
+nlohmann::json to_json(const PoseNees& nees) {
+  return {{"skipped", nees.skipped},
+          {"pose", band_json(nees.pose)},
+          {"translation", band_json(nees.translation)},
+          {"stamps", nees.stamps},
+          {"values", nees.values}};
+}
+
+std::string format_table(const PoseNees& nees) {
+  return band_line("pose NEES (6 dof, aligned at the first pose)", nees.pose) + band_line("translation NEES (3 dof)", nees.translation) +
+         (nees.skipped > 0
+              ? std::to_string(nees.skipped) + " pose(s) without a usable covariance (the first, or no stamp within --max-dt)\n"
+              : std::string());
+}
+
 }  // namespace mlidar::eval

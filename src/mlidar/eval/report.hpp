@@ -11,6 +11,8 @@
 //            "rotation_deg": STATS},
 //    "kitti": null | {"segments", "translation_percent", "rotation_deg_per_100m"}}
 //   STATS = {"count", "rmse", "mean", "median", "std", "min", "max"}
+//   with --covariance: "pose_nees": {"skipped", "pose": BAND, "translation": BAND, "stamps": [...], "values": [...]}
+//   BAND = {"frames", "median", "inside", "below", "above", "band_95": [low, high]} (shares in [0, 1])
 // mlidar eval calib:
 //   {"lidars": [{"name", "rotation_error_deg", "translation_error_m",
 //                "nees": null | number, "nees_bound_95": 12.59..., "nees_within_95": null | bool}]}
@@ -23,6 +25,7 @@
 
 #include "mlidar/eval/calibration_metrics.hpp"
 #include "mlidar/eval/map_metrics.hpp"
+#include "mlidar/eval/pose_nees.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 
 namespace mlidar::eval {
@@ -31,10 +34,12 @@ nlohmann::json to_json(const ErrorStats& stats);
 nlohmann::json to_json(const TrajectoryReport& report);
 nlohmann::json to_json(const std::vector<ExtrinsicError>& errors);
 nlohmann::json to_json(const MapMetrics& metrics, const MapMetricsOptions& options);
+nlohmann::json to_json(const PoseNees& nees);
 
 /// Short human-readable tables (a few lines each).
 std::string format_table(const TrajectoryReport& report);
 std::string format_table(const std::vector<ExtrinsicError>& errors);
 std::string format_table(const MapMetrics& metrics, const MapMetricsOptions& options);
+std::string format_table(const PoseNees& nees);
 
 }  // namespace mlidar::eval

@@ -141,6 +141,8 @@ TrajectoryReport evaluate_trajectory(const Trajectory& gt, const Trajectory& est
   report.est_poses = est.size();
   report.gt = poses_at(gt, association.gt);
   const std::vector<SE3> est_raw = poses_at(est, association.est);
+  report.est = est_raw;
+  report.est_index = association.est;
   report.stamps.resize(association.size());
   for (std::size_t i = 0; i < association.size(); ++i) report.stamps[i] = gt.poses[association.gt[i]].stamp;
   report.alignment = compute_alignment(options.align, report.gt, est_raw, est_source);

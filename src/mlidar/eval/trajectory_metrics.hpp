@@ -64,9 +64,11 @@ struct TrajectoryReport {
   std::size_t gt_poses = 0;
   std::size_t est_poses = 0;
   Alignment alignment;
-  std::vector<double> stamps;    ///< ground-truth stamps of the associated poses
-  std::vector<SE3> gt;           ///< associated ground-truth poses
-  std::vector<SE3> est_aligned;  ///< associated estimated poses after alignment
+  std::vector<double> stamps;          ///< ground-truth stamps of the associated poses
+  std::vector<SE3> gt;                 ///< associated ground-truth poses
+  std::vector<SE3> est_aligned;        ///< associated estimated poses after alignment
+  std::vector<SE3> est;                ///< the same before alignment
+  std::vector<std::size_t> est_index;  ///< each one's index in the estimated trajectory
   AteResult ate;
   RpeResult rpe;  ///< on the aligned estimate (matters for sim3)
   std::optional<KittiOdometryResult> kitti;
