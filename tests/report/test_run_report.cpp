@@ -2,6 +2,7 @@
 // verdicts in words, the extrinsic errors against ground truth (computed here
 // independently), nothing fetched, the same bytes for the same folder, and
 // clear errors for folders that are no run.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +14,7 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/point_table.hpp"
+#include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/report/run_report.hpp"
 #include "test_support.hpp"
@@ -92,6 +94,14 @@ Fixture make_run(bool with_run_json) {
   io::write_extrinsics(f.dataset / "groundtruth" / "extrinsics.yaml", truth);
   io::write_tum(f.run / "trajectory.tum", straight_line(1.0, 0.0));
   io::write_tum(f.dataset / "groundtruth" / "trajectory.tum", straight_line(1.02, 0.0));
+  // Pose covariances growing as k (0.01 m)^2 per axis along x, y, z and k (0.1 deg)^2 in rotation.
+  std::vector<io::StampedCovariance> covariances;
+  for (int k = 0; k < kFrames; ++k) {
+    Vec6 variances;
+    variances << Vec3::Constant(1e-4 * k), Vec3::Constant(std::pow(deg_to_rad(0.1), 2) * k);
+    covariances.push_back({0.1 * k, Mat6(variances.asDiagonal())});
+  }
+  io::write_pose_covariances(f.run / "pose_covariance.txt", covariances);
   std::ofstream(f.run / "metrics.json") << slam_metrics(f.T_right_estimate).dump();
   // A map: a 10 x 4 m floor at z = 0 and one post 2 m high at (5, 2).
   Scan map;
@@ -138,7 +148,15 @@ TEST(RunReport, HasTheSectionsItsDataAllowWithVerdictsInWords) {
   char expected[96];
   std::snprintf(expected, sizeof expected, "<td>1.000 / 2.00</td><td>%.2f</td>", nees);
   EXPECT_NE(extrinsics.find(expected), std::string::npos) << expected << "\n" << extrinsics;
-  EXPECT_NE(section(html, "trajectory").find("ATE (SE(3)-aligned) RMSE"), std::string::npos);
+  const std::string trajectory = section(html, "trajectory");
+  EXPECT_NE(trajectory.find("ATE (SE(3)-aligned) RMSE"), std::string::npos);
+  EXPECT_NE(trajectory.find("Pose uncertainty (1 sigma per axis)"), std::string::npos);
+  char sigma[160];
+  const double sd = 0.01 * std::sqrt(kFrames - 1.0);
+  std::snprintf(sigma, sizeof sigma, "Pose 1&sigma; at the last frame: x %.3f m, y %.3f m, z %.3f m; rotation %.2f&deg;", sd, sd, sd,
+                0.1 * std::sqrt(kFrames - 1.0));
+  EXPECT_NE(trajectory.find(sigma), std::string::npos) << sigma << "\n" << trajectory.substr(trajectory.find("Pose 1"), 300);
+  EXPECT_NE(trajectory.find("inside the 95 % NEES band"), std::string::npos);
   // The map: the floor in the lowest colour, the post's cell in the highest (heights clipped to the 2nd-98th percentile).
   const std::string map = section(html, "map");
   EXPECT_NE(map.find("4341 points"), std::string::npos) << map.substr(0, 300);

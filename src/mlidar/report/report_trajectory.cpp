@@ -1,7 +1,13 @@
 // The trajectory section of report.html: top and side views with equal axes,
-// the ground truth and the error over time when the dataset has them.
+// the ground truth and the error over time when the dataset has them, and the
+// poses' 1-sigma over time from pose_covariance.txt (with the NEES against the
+// ground truth when there is one).
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
+#include "mlidar/core/conversions.hpp"
+#include "mlidar/eval/pose_nees.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 #include "mlidar/report/report_sections.hpp"
 #include "mlidar/report/svg_chart.hpp"
@@ -33,6 +39,50 @@ Chart view(const std::string& title, int horizontal, int vertical, const std::ve
   chart.series.push_back({truth != nullptr ? "estimate (aligned, SE(3))" : "estimate", kEstimateColour, positions(estimate, horizontal),
                           positions(estimate, vertical)});
   return chart;
+}
+
+/// The translation 1-sigma per axis over time (log scale: it grows by decades along a run).
+Chart uncertainty_chart(const std::vector<io::StampedCovariance>& covariances) {
+  Chart chart;
+  chart.title = "Pose uncertainty (1 sigma per axis)";
+  chart.x_label = "time (s)";
+  chart.y_label = "sigma (m)";
+  chart.log_y = true;
+  static const char* const kAxes[] = {"x", "y", "z"};
+  static const char* const kColours[] = {"#d62728", "#2ca02c", "#1f77b4"};
+  for (int axis = 0; axis < 3; ++axis) {
+    Series series{std::string("sigma ") + kAxes[axis], kColours[axis], {}, {}};
+    for (const io::StampedCovariance& c : covariances) {
+      series.x.push_back(c.stamp - covariances.front().stamp);
+      series.y.push_back(std::sqrt(std::max(0.0, c.covariance(axis, axis))));
+    }
+    chart.series.push_back(std::move(series));
+  }
+  return chart;
+}
+
+/// The last pose's 1-sigma in words and, with a ground truth, how often the error lies inside its 95 % band.
+std::string uncertainty_words(const RunData& run, const std::optional<eval::TrajectoryReport>& evaluated) {
+  const Mat6& last = run.pose_covariances.back().covariance;
+  const auto sd = [&](int k) { return std::sqrt(std::max(0.0, last(k, k))); };
+  std::ostringstream html;
+  html << "<p>Pose 1&sigma; at the last frame: x " << fixed(sd(0), 3) << " m, y " << fixed(sd(1), 3) << " m, z " << fixed(sd(2), 3)
+       << " m; rotation " << fixed(rad_to_deg(std::max({sd(3), sd(4), sd(5)})), 2)
+       << "&deg; (largest axis). It grows from zero at the first frame (pose_covariance.txt).";
+  if (evaluated) {
+    try {
+      std::vector<double> stamps;
+      for (const StampedPose& p : run.trajectory->poses) stamps.push_back(p.stamp);
+      const eval::PoseNees nees = eval::evaluate_pose_nees(*evaluated, run.pose_covariances, "pose_covariance.txt", stamps);
+      html << " Against the ground truth (aligned at the first pose): " << fixed(100 * nees.pose.inside, 0)
+           << " % of the frames inside the 95 % NEES band (" << fixed(100 * nees.pose.below, 0)
+           << " % below: the covariance is larger than the error; " << fixed(100 * nees.pose.above, 0) << " % above: smaller).";
+    } catch (const std::exception& error) {
+      html << " Not compared with the ground truth: " << escape_markup(error.what());
+    }
+  }
+  html << "</p>\n";
+  return html.str();
 }
 
 }  // namespace
@@ -70,7 +120,9 @@ std::optional<Section> trajectory_section(const RunData& run) {
     error.lines.push_back({0.0, "", "#999"});
     html << render_svg(error);
   }
+  if (!run.pose_covariances.empty()) html << render_svg(uncertainty_chart(run.pose_covariances));
   html << "</div>\n";
+  if (!run.pose_covariances.empty()) html << uncertainty_words(run, evaluated);
   return Section{"trajectory", "Trajectory", html.str()};
 }
 

@@ -74,6 +74,9 @@ RunData load_run(const fs::path& folder, const ReportSource& source) {
     run.metrics = read_json(folder / "calibration.json");
   run.trajectory = read_optional<Trajectory>(
       folder / "trajectory.tum", [](const fs::path& p) { return io::read_tum(p); }, run.notes);
+  if (auto covariances = read_optional<std::vector<io::StampedCovariance>>(
+          folder / "pose_covariance.txt", [](const fs::path& p) { return io::read_pose_covariances(p); }, run.notes))
+    run.pose_covariances = std::move(*covariances);
   run.extrinsics = read_optional<io::Extrinsics>(
       folder / "extrinsics.yaml", [](const fs::path& p) { return io::read_extrinsics(p); }, run.notes);
   if (auto points = read_optional<std::vector<Eigen::Vector3f>>(

@@ -18,6 +18,7 @@
 
 #include "mlidar/core/types.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/pose_covariance_io.hpp"
 
 namespace mlidar::report {
 
@@ -30,6 +31,7 @@ struct RunData {
   nlohmann::json run_info;   ///< run.json (null before the run is committed)
   nlohmann::json metrics;    ///< metrics.json or calibration.json (null when absent)
   std::optional<Trajectory> trajectory;
+  std::vector<io::StampedCovariance> pose_covariances;  ///< pose_covariance.txt (empty when absent)
   std::optional<io::Extrinsics> extrinsics;
   std::vector<Eigen::Vector3f> map;             ///< map.ply's points (empty when absent)
   std::optional<Trajectory> gt_trajectory;      ///< DATASET/groundtruth/trajectory.tum
