@@ -8,6 +8,7 @@
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
+#include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/report/run_report.hpp"
 #include "mlidar/sim/lidar_models.hpp"
 
@@ -60,6 +61,8 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
             << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost, " << summary.suspect_frames.size()
             << " suspect\n";
   for (const auto& line : summary.front_end) std::cout << "note: " << line << '\n';
+  std::cout << "note: last pose 1-sigma " << pipelines::pose_sigma_words(summary.last_pose_covariance)
+            << " (grown from 0 at the first frame; every frame's in pose_covariance.txt)\n";
   if (summary.degenerate_frames > 0) {
     std::cerr << "warning: " << summary.degenerate_frames << " frame(s) degenerate (translation weakly constrained, e.g. a corridor): ";
     for (std::size_t i = 0; i < summary.degenerate_directions.size(); ++i)

@@ -7,6 +7,7 @@
 #include "apps/mlidar/bag_options.hpp"
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
+#include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/pipelines/slam_job.hpp"
 #include "mlidar/report/run_report.hpp"
 
@@ -85,6 +86,8 @@ int run_slam(SlamOptions options, const CliContext& context) {
   std::cout << "wrote " << options.job.out.string() << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3
             << " ms per frame, " << summary.lost_frames << " lost, " << summary.suspect_frames.size() << " suspect\n";
   for (const auto& lidar : summary.lidars) print_lidar(lidar);
+  std::cout << "note: last pose 1-sigma " << pipelines::pose_sigma_words(summary.last_pose_covariance)
+            << " (grown from 0 at the first frame; every frame's in pose_covariance.txt)\n";
   if (!summary.all_converged())
     std::cerr
         << "warning: some LiDAR's calibration did not converge; its extrinsic in extrinsics.yaml has no covariance (see metrics.json)\n";

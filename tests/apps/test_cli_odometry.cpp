@@ -139,6 +139,7 @@ TEST(CliOdometry, ScanFolderOfOneLidarTracksThatLidar) {
       run_cli("odometry --scans " + quoted((sim / "scans" / "top").string()) + " --period 0.1 --out " + quoted(run.string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("rows from its ring channel in 8 of 8 frames (16 rings"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("note: last pose 1-sigma x "), std::string::npos) << result.output;
   const Trajectory est = read_run_folder(run);
   // The folder's trajectory is the top LiDAR's: T_world_top = T_world_base T_base_top.
   Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");

@@ -81,6 +81,7 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   const fs::path run = dir / "run";
   const CliResult result = run_cli("slam --dataset " + quoted(sim.string()) + " --out " + quoted(run.string()));
   ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("note: last pose 1-sigma x "), std::string::npos) << result.output;
 
   const io::Extrinsics truth = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
   const io::Extrinsics estimate = io::read_extrinsics(run / "extrinsics.yaml");

@@ -112,6 +112,7 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   write_map_ply(job.out / "map.ply", odometry);
   const std::vector<io::StampedCovariance> covariances = pose_covariances(results);
   io::write_pose_covariances(job.out / "pose_covariance.txt", covariances);
+  if (!covariances.empty()) summary.last_pose_covariance = covariances.back().covariance;
   nlohmann::json metrics = odometry_metrics_json(results, lidars);
   add_pose_covariance_traces(metrics, covariances);
   metrics["skipped_scans"] = gaps.json();

@@ -50,9 +50,10 @@ struct OdometryJobSummary {
   std::vector<std::size_t> suspect_frames;  ///< frame indices whose pose is doubtful (FrameResult::suspect)
   double mean_frame_seconds = 0.0;
   Trajectory trajectory;
-  std::vector<std::string> gaps;            ///< per LiDAR with skipped or missing scans, in words
-  std::vector<std::string> front_end;       ///< per LiDAR without a model: rows recovered or voxel samples, in words
-  std::optional<std::string> base_failure;  ///< the base LiDAR lacked too many frames (exit 1)
+  std::vector<std::string> gaps;             ///< per LiDAR with skipped or missing scans, in words
+  std::vector<std::string> front_end;        ///< per LiDAR without a model: rows recovered or voxel samples, in words
+  std::optional<std::string> base_failure;   ///< the base LiDAR lacked too many frames (exit 1)
+  Mat6 last_pose_covariance = Mat6::Zero();  ///< the last frame's, as pose_covariance.txt holds it
 };
 
 /// UsageError for a bad combination of options; InputError for bad files.

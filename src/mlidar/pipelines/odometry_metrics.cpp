@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "mlidar/core/covariance.hpp"
 #include "mlidar/io/cloud_file.hpp"
@@ -76,6 +77,14 @@ std::vector<io::StampedCovariance> pose_covariances(const std::vector<slam::Fram
     out.push_back({frames[k].stamp, M * left * M.transpose()});
   }
   return out;
+}
+
+std::string pose_sigma_words(const Mat6& covariance) {
+  const auto sd = [&](int k) { return std::sqrt(std::max(0.0, covariance(k, k))); };
+  char text[160];
+  std::snprintf(text, sizeof text, "x %.3g m, y %.3g m, z %.3g m, rotation %.2g deg", sd(0), sd(1), sd(2),
+                std::max({sd(3), sd(4), sd(5)}) * 180.0 / M_PI);
+  return text;
 }
 
 void add_pose_covariance_traces(nlohmann::json& metrics, const std::vector<io::StampedCovariance>& covariances) {

@@ -21,6 +21,10 @@ namespace mlidar::pipelines {
 /// pose_covariance.txt's tangent, at the frame's stamp.
 std::vector<io::StampedCovariance> pose_covariances(const std::vector<slam::FrameResult>& frames);
 
+/// "x 0.012 m, y 0.015 m, z 0.018 m, rotation 0.04 deg": the 1-sigmas of a pose covariance (pose_covariance.txt's
+/// tangent; rotation: the largest axis).
+std::string pose_sigma_words(const Mat6& covariance);
+
 /// metrics.json per frame: `pose_covariance_trace` (m^2 + rad^2) from `covariances` (one per frame).
 void add_pose_covariance_traces(nlohmann::json& metrics, const std::vector<io::StampedCovariance>& covariances);
 

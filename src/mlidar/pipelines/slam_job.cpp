@@ -153,6 +153,7 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
   const std::vector<io::StampedCovariance> covariances = pose_covariances(run, frame, summary.trajectory);
   io::write_pose_covariances(job.out / "pose_covariance.txt", covariances);
+  if (!covariances.empty()) summary.last_pose_covariance = covariances.back().covariance;
   write_extrinsics_file(job.out / "extrinsics.yaml", frame, summary.lidars);
   std::vector<Eigen::Vector3f> map = estimator.map_points();
   for (Eigen::Vector3f& p : map) p = frame.point_to_base(p);

@@ -43,10 +43,11 @@ struct SlamJobSummary {
   std::vector<std::size_t> suspect_frames;  ///< frame indices whose base pose is doubtful
   double mean_frame_seconds = 0.0;
   Trajectory trajectory;
-  std::vector<SlamLidarReport> lidars;      ///< dataset order
-  std::vector<std::string> gaps;            ///< per LiDAR with skipped or missing scans, in words
-  std::optional<std::string> base_failure;  ///< the base LiDAR lacked too many frames (exit 1)
-  bool all_converged() const;               ///< every LiDAR trusted at the end
+  std::vector<SlamLidarReport> lidars;       ///< dataset order
+  std::vector<std::string> gaps;             ///< per LiDAR with skipped or missing scans, in words
+  std::optional<std::string> base_failure;   ///< the base LiDAR lacked too many frames (exit 1)
+  Mat6 last_pose_covariance = Mat6::Zero();  ///< the last frame's, as pose_covariance.txt holds it
+  bool all_converged() const;                ///< every LiDAR trusted at the end
 };
 
 /// UsageError for bad options; InputError for bad files (dataset, config).
