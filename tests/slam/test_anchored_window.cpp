@@ -118,11 +118,9 @@ TEST(AnchoredWindow, MarginalizingThePivotEqualsTheSchurComplementOfTheFullProbl
   J_old.leftCols(12) = old.jacobian;
   const Eigen::MatrixXd H = J.transpose() * J + J_old.transpose() * J_old;
   const Eigen::VectorXd g = J.transpose() * r + J_old.transpose() * prior_residual(old, w.state);
-  const Eigen::Index n = layout.size;
-  const Eigen::MatrixXd H_mm_inv = H.topLeftCorner(6, 6).inverse();
-  const Eigen::MatrixXd H_rm = H.bottomLeftCorner(n - 6, 6);
-  const Eigen::MatrixXd schur_H = H.bottomRightCorner(n - 6, n - 6) - H_rm * H_mm_inv * H_rm.transpose();
-  const Eigen::VectorXd schur_g = g.tail(n - 6) - H_rm * H_mm_inv * g.head(6);
+  Eigen::MatrixXd schur_H;
+  Eigen::VectorXd schur_g;
+  test::schur_without_first_pose(H, g, schur_H, schur_g);
 
   const LinearPrior prior = marginalize_frame(w.problem, w.state, 0, kHuberOff);
   // Every map term touches the pivot: the prior holds both later poses and the extrinsic, nothing is left outside it.

@@ -96,12 +96,10 @@ TEST(Marginalization, PriorEqualsSchurComplementOfTheFullProblem) {
   Eigen::MatrixXd H;
   Eigen::VectorXd g;
   full_system(w, layout, H, g);
-  // Eq 4.41 by hand, explicit inverse of H_mm.
   const Eigen::Index n = layout.size;
-  const Eigen::MatrixXd H_mm_inv = H.topLeftCorner(6, 6).inverse();
-  const Eigen::MatrixXd H_rm = H.bottomLeftCorner(n - 6, 6);
-  const Eigen::MatrixXd schur_H = H.bottomRightCorner(n - 6, n - 6) - H_rm * H_mm_inv * H_rm.transpose();
-  const Eigen::VectorXd schur_g = g.tail(n - 6) - H_rm * H_mm_inv * g.head(6);
+  Eigen::MatrixXd schur_H;
+  Eigen::VectorXd schur_g;
+  test::schur_without_first_pose(H, g, schur_H, schur_g);
 
   const LinearPrior prior = marginalize_frame(w.problem, w.state, 0, kHuberOff);
   ASSERT_EQ(prior.variables.size(), 2u);  // pose 1 (through the old prior) and the auxiliary extrinsic

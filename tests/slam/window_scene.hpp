@@ -3,6 +3,8 @@
 // planes and lines, poses and extrinsics, and feature points that lie exactly
 // on them (so every residual is zero at the true state).
 #include <random>
+
+#include <Eigen/LU>
 #include <vector>
 
 #include "mlidar/core/so3.hpp"
@@ -72,6 +74,17 @@ inline SE3 perturb(const SE3& T, double translation_m, double rotation_rad, std:
   delta << Vec3(normal(rng), normal(rng), normal(rng)).normalized() * translation_m,
       Vec3(normal(rng), normal(rng), normal(rng)).normalized() * rotation_rad;
   return SE3::exp(delta) * T;
+}
+
+/// Eq 4.41 written out with an explicit inverse: the Schur complement of H dx = -g onto every column after the
+/// first 6 (the first pose eliminated), the reference the marginalization tests compare against.
+inline void schur_without_first_pose(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd& schur_H,
+                                     Eigen::VectorXd& schur_g) {
+  const Eigen::Index n = H.rows();
+  const Eigen::MatrixXd H_mm_inv = H.topLeftCorner(6, 6).inverse();
+  const Eigen::MatrixXd H_rm = H.bottomLeftCorner(n - 6, 6);
+  schur_H = H.bottomRightCorner(n - 6, n - 6) - H_rm * H_mm_inv * H_rm.transpose();
+  schur_g = g.tail(n - 6) - H_rm * H_mm_inv * g.head(6);
 }
 
 /// Tangent distance |Log(a b^-1)|.

@@ -54,8 +54,7 @@ double integrated_autocorrelation_time(std::span<const Vec6> deviations) {
 }
 
 Mat6 local_covariance_from_left_information(const SE3& T, const Mat6& information, double residual_variance) {
-  const Mat6 M = left_to_local_tangent(T);
-  return M * (residual_variance * pseudo_inverse(information)) * M.transpose();
+  return covariance_in_local_tangent(T, residual_variance * pseudo_inverse(information));
 }
 
 CalibrationCovariance calibration_covariance(std::span<const Vec6> deviations, std::span<const Mat6> window_covariances, double min_tau) {

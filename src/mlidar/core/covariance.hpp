@@ -26,4 +26,13 @@ inline Mat6 left_to_local_tangent(const SE3& T) {
   return M;
 }
 
+/// A left-perturbation covariance at T (world frame) in the [t additive, r local] tangent: M C M^T.
+inline Mat6 covariance_in_local_tangent(const SE3& T, const Mat6& left_covariance) {
+  const Mat6 M = left_to_local_tangent(T);
+  return M * left_covariance * M.transpose();
+}
+
+/// The 1-sigma of each axis of a covariance (0 for a negative diagonal entry).
+inline Vec6 axis_sigmas(const Mat6& covariance) { return covariance.diagonal().cwiseMax(0.0).cwiseSqrt(); }
+
 }  // namespace mlidar

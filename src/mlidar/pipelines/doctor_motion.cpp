@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/slam/odometry.hpp"
 
 namespace mlidar::pipelines {
@@ -33,7 +34,7 @@ MotionSummary BaseMotion::summary(double frame_period, const MotionCheckConfig& 
     if (!poses_[k] || !poses_[k + step]) continue;
     ++out.pairs;
     const Vec3 rotation = (poses_[k]->inverse() * *poses_[k + step]).log().tail<3>();  // in the base frame at k
-    const double degrees = rotation.norm() * 180.0 / M_PI;
+    const double degrees = rad_to_deg(rotation.norm());
     out.largest_turn_deg = std::max(out.largest_turn_deg, degrees);
     if (degrees < config.turn_deg) continue;
     ++out.turning_pairs;

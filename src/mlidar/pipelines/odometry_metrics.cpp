@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/covariance.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/slam/pose_covariance.hpp"
@@ -72,18 +73,16 @@ std::vector<io::StampedCovariance> pose_covariances(const std::vector<slam::Fram
   slam::PoseCovarianceChain chain;
   std::vector<io::StampedCovariance> out;
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    const Mat6& left = chain.add(frames[k], k == 0);
-    const Mat6 M = left_to_local_tangent(frames[k].T_world_base);
-    out.push_back({frames[k].stamp, M * left * M.transpose()});
+    out.push_back({frames[k].stamp, covariance_in_local_tangent(frames[k].T_world_base, chain.add(frames[k], k == 0))});
   }
   return out;
 }
 
 std::string pose_sigma_words(const Mat6& covariance) {
-  const auto sd = [&](int k) { return std::sqrt(std::max(0.0, covariance(k, k))); };
+  const Vec6 sigma = axis_sigmas(covariance);
   char text[160];
-  std::snprintf(text, sizeof text, "x %.3g m, y %.3g m, z %.3g m, rotation %.2g deg", sd(0), sd(1), sd(2),
-                std::max({sd(3), sd(4), sd(5)}) * 180.0 / M_PI);
+  std::snprintf(text, sizeof text, "x %.3g m, y %.3g m, z %.3g m, rotation %.2g deg", sigma(0), sigma(1), sigma(2),
+                rad_to_deg(sigma.tail<3>().maxCoeff()));
   return text;
 }
 

@@ -101,8 +101,7 @@ std::vector<io::StampedCovariance> pose_covariances(const SlamRun& run, const Ba
   std::vector<io::StampedCovariance> out;
   for (std::size_t k = 0; k < run.frames.size(); ++k) {
     const Mat6 left = to_base * run.frames[k].pose_covariance * to_base.transpose();
-    const Mat6 M = left_to_local_tangent(trajectory.poses[k].T_world_base);
-    out.push_back({trajectory.poses[k].stamp, M * left * M.transpose()});
+    out.push_back({trajectory.poses[k].stamp, covariance_in_local_tangent(trajectory.poses[k].T_world_base, left)});
   }
   return out;
 }

@@ -2,11 +2,11 @@
 // the ground truth and the error over time when the dataset has them, and the
 // poses' 1-sigma over time from pose_covariance.txt (with the NEES against the
 // ground truth when there is one).
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "mlidar/core/conversions.hpp"
+#include "mlidar/core/covariance.hpp"
 #include "mlidar/eval/pose_nees.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 #include "mlidar/report/report_sections.hpp"
@@ -54,7 +54,7 @@ Chart uncertainty_chart(const std::vector<io::StampedCovariance>& covariances) {
     Series series{std::string("sigma ") + kAxes[axis], kColours[axis], {}, {}};
     for (const io::StampedCovariance& c : covariances) {
       series.x.push_back(c.stamp - covariances.front().stamp);
-      series.y.push_back(std::sqrt(std::max(0.0, c.covariance(axis, axis))));
+      series.y.push_back(axis_sigmas(c.covariance)(axis));
     }
     chart.series.push_back(std::move(series));
   }
@@ -63,11 +63,10 @@ Chart uncertainty_chart(const std::vector<io::StampedCovariance>& covariances) {
 
 /// The last pose's 1-sigma in words and, with a ground truth, how often the error lies inside its 95 % band.
 std::string uncertainty_words(const RunData& run, const std::optional<eval::TrajectoryReport>& evaluated) {
-  const Mat6& last = run.pose_covariances.back().covariance;
-  const auto sd = [&](int k) { return std::sqrt(std::max(0.0, last(k, k))); };
+  const Vec6 sigma = axis_sigmas(run.pose_covariances.back().covariance);
   std::ostringstream html;
-  html << "<p>Pose 1&sigma; at the last frame: x " << fixed(sd(0), 3) << " m, y " << fixed(sd(1), 3) << " m, z " << fixed(sd(2), 3)
-       << " m; rotation " << fixed(rad_to_deg(std::max({sd(3), sd(4), sd(5)})), 2)
+  html << "<p>Pose 1&sigma; at the last frame: x " << fixed(sigma(0), 3) << " m, y " << fixed(sigma(1), 3) << " m, z " << fixed(sigma(2), 3)
+       << " m; rotation " << fixed(rad_to_deg(sigma.tail<3>().maxCoeff()), 2)
        << "&deg; (largest axis). It grows from zero at the first frame (pose_covariance.txt).";
   if (evaluated) {
     try {
