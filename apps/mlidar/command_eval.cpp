@@ -13,7 +13,9 @@
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
+#include "mlidar/io/point_covariance_fields.hpp"
 #include "mlidar/io/pose_covariance_io.hpp"
+#include "mlidar/io/surface_samples.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 
 namespace mlidar::cli {
@@ -43,6 +45,8 @@ struct MapOptions {
   double radius = 0.3;
   std::size_t min_neighbors = 5;
   std::string json_out;
+  std::string gt_surfaces;
+  double max_surface_distance = 0.5;
 };
 
 void write_json(const std::string& path, const nlohmann::json& json) {
@@ -113,9 +117,29 @@ int run_map(const MapOptions& options) {
   const io::CloudFile cloud = io::read_cloud(options.map);
   const Scan scan = io::to_scan(cloud.table, options.map);
   const eval::MapMetricsOptions metrics_options{.radius = options.radius, .min_neighbors = options.min_neighbors};
-  const eval::MapMetrics metrics = eval::compute_map_metrics(scan.points, metrics_options);
+  eval::MapMetrics metrics = eval::compute_map_metrics(scan.points, metrics_options);
+  // The covariances belong to the points as the file holds them (to_scan drops non-finite points: a map with
+  // covariances has none, so both stay aligned; the check reads the table itself).
+  const auto covariances = io::read_point_covariances(cloud.table, options.map);
+  if (covariances) {
+    if (covariances->size() != scan.points.size())
+      throw InputError(options.map, "x y z", "non-finite points in a map with covariances: every point needs a position");
+    std::vector<double> traces;
+    traces.reserve(covariances->size());
+    for (const io::UpperCovariance& c : *covariances) traces.push_back(static_cast<double>(c[0]) + c[3] + c[5]);
+    metrics.covariance_trace = eval::summarize_traces(std::move(traces));
+  }
   std::cout << eval::format_table(metrics, metrics_options);
-  write_json(options.json_out, eval::to_json(metrics, metrics_options));
+  nlohmann::json json = eval::to_json(metrics, metrics_options);
+  json["gt_surfaces"] = nullptr;
+  if (!options.gt_surfaces.empty()) {
+    const eval::SurfaceErrorOptions surface_options{.max_distance_m = options.max_surface_distance};
+    const eval::SurfaceError error =
+        eval::surface_error(scan.points, covariances, io::read_surface_samples(options.gt_surfaces), surface_options);
+    std::cout << eval::format_table(error, surface_options);
+    json["gt_surfaces"] = eval::to_json(error, surface_options);
+  }
+  write_json(options.json_out, json);
   return 0;
 }
 
@@ -153,6 +177,13 @@ void add_map(CLI::App& eval_app, std::shared_ptr<MapOptions> options) {
   sub->add_option("--min-neighbors", options->min_neighbors, "Fewest neighbours (self included) for a point to count")
       ->capture_default_str();
   sub->add_option("--json", options->json_out, "Write the metrics as JSON to this file");
+  sub->add_option("--gt-surfaces", options->gt_surfaces,
+                  "True surfaces (x y z nx ny nz PLY, e.g. a simulated dataset's groundtruth/surfaces.ply) in the map's frame: each "
+                  "point's distance to them and, with point covariances, its normalized error");
+  sub->add_option("--max-surface-distance", options->max_surface_distance,
+                  "Map points farther than this (m) from the true surfaces are not matched")
+      ->check(CLI::Range(1e-6, 1e6))
+      ->capture_default_str();
 }
 
 }  // namespace

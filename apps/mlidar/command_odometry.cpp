@@ -53,6 +53,7 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
   job.threads = options.threads;
   job.max_base_gaps = options.max_base_gaps;
   job.config = options.config;
+  if (job.bag.empty()) job.extrinsics = options.bag.extrinsics;  // a dataset's or clouds' extrinsics replaced (a bag's: bag_options)
   job.out = run.path();
   const auto summary = pipelines::run_odometry_job(job, terminal_progress_bar());
   report::write_run_report(run.path(), {"odometry", options.dataset, options.out});

@@ -25,6 +25,7 @@ struct DriveOptions {
   std::uint64_t seed = 1;
   std::string perturb = "0,0";
   std::string encoding = "binary";
+  double surfaces = 0.0;
   bool overwrite = false;
   std::string out;
 };
@@ -77,6 +78,7 @@ int run_drive(const DriveOptions& options, const CliContext& context) {
   spec.perturb_deg = perturb[0];
   spec.perturb_m = perturb[1];
   spec.encoding = io::pcd_encoding_from_name(options.encoding);
+  spec.surface_spacing_m = options.surfaces;
   sim::write_drive_dataset(spec, run.path(), terminal_progress_bar());
   run.commit();
   std::cout << "wrote " << options.out << ": " << spec.frames << " frames of " << spec.rig.lidars.size() << " LiDAR(s), rig "
@@ -114,6 +116,11 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
   drive_cmd->add_option("--encoding", drive->encoding, "PCD encoding of the scans (binary_compressed: about a third smaller)")
       ->check(CLI::IsMember({"binary", "binary_compressed"}))
       ->capture_default_str();
+  drive_cmd
+      ->add_option("--surfaces", drive->surfaces,
+                   "Also write groundtruth/surfaces.ply: the scenery's exact hits, one per cube of this edge (m, e.g. 0.1), with normals, "
+                   "for `eval map --gt-surfaces`")
+      ->check(CLI::Range(0.01, 10.0));
   drive_cmd->add_option("--out", drive->out, "Dataset folder (a new or empty folder, or an earlier simulate output)")->required();
   add_overwrite_flag(*drive_cmd, drive->overwrite);
 

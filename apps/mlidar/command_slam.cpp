@@ -78,6 +78,7 @@ int run_slam(SlamOptions options, const CliContext& context) {
   pipelines::SlamJob job = options.job;
   job.bag = options.bag.bag;
   job.bag_options = bag_source_options(options.bag);
+  if (job.bag.empty()) job.extrinsics = options.bag.extrinsics;  // a dataset's extrinsics replaced (a bag's: bag_options)
   job.calibrate = extrinsic_source(options.calibrate);
   job.out = run.path();
   const auto summary = pipelines::run_slam_job(job, terminal_progress_bar());

@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 52u);
+  EXPECT_EQ(slam_config_keys().size(), 60u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -129,7 +129,11 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
       "  degeneracy_interval_s: 2\n  epsilon: 0.4\n  time_budget_ms: 3\n  seed: 12\n  min_features: 40\n"
-      "  held_out_share: 0.5\n  held_out_residual_ratio: 2\n  held_out_residual_floor_m: 0.02\n";
+      "  held_out_share: 0.5\n  held_out_residual_ratio: 2\n  held_out_residual_floor_m: 0.02\n"
+      "mapping:\n"
+      "  uncertainty_aware: true\n  trace_threshold_m2: 0.3\n  residual_sigma_m: 0.07\n  range_sigma_m: 0.05\n"
+      "  angular_sigma_rad: 0.002\n  voxel_filter_m: 0.25\n  extrinsic_prior_translation_m: 0.03\n"
+      "  extrinsic_prior_rotation_deg: 1.5\n";
   for (const SlamConfigKey& key : slam_config_keys()) {  // every key, each set to a value other than its default
     const std::string section = key.name.substr(0, key.name.find('.'));
     const std::string leaf = key.name.substr(key.name.find('.') + 1);
@@ -191,6 +195,15 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(sel.held_out_residual_floor_m, 0.02);
   EXPECT_EQ(c.odometry.registration.huber_delta_m, 0.05);
   EXPECT_FALSE(c.odometry.front_end.recover_rows);
+  const slam::UncertaintyConfig& ua = c.odometry.uncertainty;
+  EXPECT_TRUE(ua.enabled);
+  EXPECT_EQ(ua.trace_threshold_m2, 0.3);
+  EXPECT_EQ(ua.residual_sigma_m, 0.07);
+  EXPECT_EQ(ua.range_sigma_m, 0.05);
+  EXPECT_EQ(ua.angular_sigma_rad, 0.002);
+  EXPECT_EQ(ua.voxel_filter_m, 0.25);
+  EXPECT_EQ(c.mapping.extrinsic_prior_translation_m, 0.03);
+  EXPECT_EQ(c.mapping.extrinsic_prior_rotation_deg, 1.5);
 }
 
 struct Rejection {

@@ -3,6 +3,8 @@
 // ground truth, bad input leaves nothing behind.
 #include <cmath>
 #include <numbers>
+#include <set>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -12,6 +14,7 @@
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/io/kitti.hpp"
 #include "mlidar/io/pcd.hpp"
+#include "mlidar/io/surface_samples.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/sim/corner_dataset.hpp"
 #include "mlidar/sim/drive_dataset.hpp"
@@ -94,6 +97,46 @@ TEST(DriveDataset, WrittenPointsLieInTheirWrittenBoxes) {
     for (const auto& p : cloud.points) inside += box_contains(box, p.cast<double>(), 1e-4);
   }
   EXPECT_GT(inside, 20);
+}
+
+TEST(DriveDataset, SurfaceSamplesLieUnderTheNoiseFreePointsInTheFirstBaseFrame) {
+  DriveSpec spec;
+  spec.rig = named_rig("rhd");
+  for (auto& lidar : spec.rig.lidars) {
+    lidar.model.horizontal_resolution_deg = 2.0;
+    lidar.model.range_noise_sigma = 0.0;
+    lidar.dropout_probability = 0.0;
+  }
+  spec.scene = "room";
+  const SE3 T_world_base(so3_exp(Vec3(0.0, 0.0, 0.7)), Vec3(1.0, -2.0, 1.3));  // not the identity: the frame matters
+  spec.trajectory = SimTrajectory::stationary(T_world_base);
+  spec.frames = 2;
+  spec.surface_spacing_m = 0.05;
+  const fs::path out = test::scratch_dir() / "surfaces";
+  write_drive_dataset(spec, out);
+  const io::SurfaceSamples surfaces = io::read_surface_samples(out / "groundtruth" / "surfaces.ply");
+  ASSERT_GT(surfaces.points.size(), 1000u);
+  // One sample per 5 cm cube at most.
+  std::set<std::tuple<int, int, int>> cubes;
+  for (const Eigen::Vector3f& p : surfaces.points)
+    cubes.insert({static_cast<int>(std::floor(p.x() / 0.05F)), static_cast<int>(std::floor(p.y() / 0.05F)),
+                  static_cast<int>(std::floor(p.z() / 0.05F))});
+  EXPECT_EQ(cubes.size(), surfaces.points.size());
+  const io::Extrinsics extrinsics = io::read_extrinsics(out / "groundtruth" / "extrinsics.yaml");
+  std::size_t points = 0, on_surface = 0;
+  for (const auto& lidar : extrinsics.lidars) {
+    const Scan scan = io::to_scan(io::read_pcd(out / "scans" / lidar.name / "000001.pcd").table, lidar.name);
+    for (const Eigen::Vector3f& p_lidar : scan.points) {
+      const Eigen::Vector3f p = lidar.T_base_lidar * p_lidar;
+      std::size_t nearest = 0;
+      for (std::size_t k = 1; k < surfaces.points.size(); ++k)
+        if ((surfaces.points[k] - p).squaredNorm() < (surfaces.points[nearest] - p).squaredNorm()) nearest = k;
+      ++points;
+      on_surface += std::abs(surfaces.normals[nearest].dot(p - surfaces.points[nearest])) < 2e-3F ? 1 : 0;
+    }
+  }
+  ASSERT_GT(points, 1000u);
+  EXPECT_GT(static_cast<double>(on_surface) / static_cast<double>(points), 0.98) << on_surface << " of " << points;
 }
 
 TEST(DriveDataset, BadRequestsLeaveNothingBehind) {

@@ -32,6 +32,22 @@ inline Mat6 covariance_in_local_tangent(const SE3& T, const Mat6& left_covarianc
   return M * left_covariance * M.transpose();
 }
 
+/// The inverse of left_to_local_tangent: M^-1 = [I, [t]x R; 0, R], d = M^-1 e.
+inline Mat6 local_to_left_tangent(const SE3& T) {
+  const Mat3 R = T.rotation_matrix();
+  Mat6 M = Mat6::Zero();
+  M.topLeftCorner<3, 3>().setIdentity();
+  M.topRightCorner<3, 3>() = hat(T.translation()) * R;
+  M.bottomRightCorner<3, 3>() = R;
+  return M;
+}
+
+/// A [t additive, r local] covariance at T (extrinsics.yaml's) as a left perturbation (world / base frame).
+inline Mat6 covariance_in_left_tangent(const SE3& T, const Mat6& local_covariance) {
+  const Mat6 M = local_to_left_tangent(T);
+  return M * local_covariance * M.transpose();
+}
+
 /// The 1-sigma of each axis of a covariance (0 for a negative diagonal entry).
 inline Vec6 axis_sigmas(const Mat6& covariance) { return covariance.diagonal().cwiseMax(0.0).cwiseSqrt(); }
 

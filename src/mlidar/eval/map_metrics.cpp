@@ -117,3 +117,28 @@ MapMetrics compute_map_metrics(const std::vector<Eigen::Vector3f>& points, const
 }
 
 }  // namespace mlidar::eval
+
+namespace mlidar::eval {
+
+CovarianceTraceStats summarize_traces(std::vector<double> traces) {
+  CovarianceTraceStats stats;
+  stats.count = traces.size();
+  if (traces.empty()) {
+    stats.mean = stats.p50 = stats.p95 = stats.max = std::numeric_limits<double>::quiet_NaN();
+    return stats;
+  }
+  std::sort(traces.begin(), traces.end());
+  const auto rank = [&](double q) {  // nearest rank: the smallest value with at least q of the values at or below it
+    const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(traces.size())));
+    return traces[std::max<std::size_t>(k, 1) - 1];
+  };
+  double sum = 0.0;
+  for (const double t : traces) sum += t;
+  stats.mean = sum / static_cast<double>(traces.size());
+  stats.p50 = rank(0.5);
+  stats.p95 = rank(0.95);
+  stats.max = traces.back();
+  return stats;
+}
+
+}  // namespace mlidar::eval

@@ -82,7 +82,13 @@ nlohmann::json to_json(const MapMetrics& metrics, const MapMetricsOptions& optio
           {"radius_m", options.radius},
           {"min_neighbors", options.min_neighbors},
           {"mean_map_entropy", number_or_null(metrics.mean_map_entropy)},
-          {"mean_plane_variance", number_or_null(metrics.mean_plane_variance)}};
+          {"mean_plane_variance", number_or_null(metrics.mean_plane_variance)},
+          {"covariance_trace", metrics.covariance_trace ? nlohmann::json{{"points", metrics.covariance_trace->count},
+                                                                         {"mean_m2", number_or_null(metrics.covariance_trace->mean)},
+                                                                         {"p50_m2", number_or_null(metrics.covariance_trace->p50)},
+                                                                         {"p95_m2", number_or_null(metrics.covariance_trace->p95)},
+                                                                         {"max_m2", number_or_null(metrics.covariance_trace->max)}}
+                                                        : nlohmann::json(nullptr)}};
 }
 
 std::string format_table(const TrajectoryReport& report) {
@@ -126,7 +132,37 @@ std::string format_table(const MapMetrics& metrics, const MapMetricsOptions& opt
   return "points: " + std::to_string(metrics.points) + " (" + std::to_string(metrics.points_used) +
          " with a full-rank neighbourhood, radius " + fixed(options.radius, 3) + " m)\n" +
          "mean map entropy:    " + fixed(metrics.mean_map_entropy) + "\n" +
-         "mean plane variance: " + fixed(metrics.mean_plane_variance, 8) + " m^2\n";
+         "mean plane variance: " + fixed(metrics.mean_plane_variance, 8) + " m^2\n" +
+         (metrics.covariance_trace
+              ? "point covariance tr(Sigma): mean " + fixed(metrics.covariance_trace->mean, 6) + ", median " +
+                    fixed(metrics.covariance_trace->p50, 6) + ", p95 " + fixed(metrics.covariance_trace->p95, 6) + ", max " +
+                    fixed(metrics.covariance_trace->max, 6) + " m^2 over " + std::to_string(metrics.covariance_trace->count) + " points\n"
+              : std::string("point covariances: none in the map\n"));
+}
+
+nlohmann::json to_json(const SurfaceError& error, const SurfaceErrorOptions& options) {
+  nlohmann::json normalized = nullptr;
+  if (error.normalized)
+    normalized = {{"points", error.normalized->count},
+                  {"mean", number_or_null(error.normalized->mean)},
+                  {"variance", number_or_null(error.normalized->variance)},
+                  {"inside_95", number_or_null(error.normalized->inside_95)}};
+  return {{"points", error.points},
+          {"matched", error.matched},
+          {"max_distance_m", options.max_distance_m},
+          {"distance_m", to_json(error.distance_m)},
+          {"normalized_error", normalized}};
+}
+
+std::string format_table(const SurfaceError& error, const SurfaceErrorOptions& options) {
+  std::string text = "distance to the true surfaces: " + std::to_string(error.matched) + " of " + std::to_string(error.points) +
+                     " points within " + fixed(options.max_distance_m, 2) + " m; |distance| mean " + fixed(error.distance_m.mean, 4) +
+                     " m, rmse " + fixed(error.distance_m.rmse, 4) + " m, max " + fixed(error.distance_m.max, 4) + " m\n";
+  if (!error.normalized) return text + "normalized error: the map has no point covariances\n";
+  return text + "normalized error along the normal: variance " + fixed(error.normalized->variance, 3) +
+         " (1 when the covariances are honest), mean " + fixed(error.normalized->mean, 3) + ", " +
+         fixed(100 * error.normalized->inside_95, 1) + " % inside the 95 % bound over " + std::to_string(error.normalized->count) +
+         " points\n";
 }
 
 namespace {

@@ -26,6 +26,7 @@
 #include "mlidar/eval/calibration_metrics.hpp"
 #include "mlidar/eval/map_metrics.hpp"
 #include "mlidar/eval/pose_nees.hpp"
+#include "mlidar/eval/surface_error.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 
 namespace mlidar::eval {
@@ -40,6 +41,10 @@ nlohmann::json to_json(const PoseNees& nees);
 std::string format_table(const TrajectoryReport& report);
 std::string format_table(const std::vector<ExtrinsicError>& errors);
 std::string format_table(const MapMetrics& metrics, const MapMetricsOptions& options);
+/// `eval map --gt-surfaces`: JSON `{points, matched, max_distance_m, distance_m {stats}, normalized_error {points, mean,
+/// variance, inside_95} | null}` and its table lines.
+nlohmann::json to_json(const SurfaceError& error, const SurfaceErrorOptions& options);
+std::string format_table(const SurfaceError& error, const SurfaceErrorOptions& options);
 std::string format_table(const PoseNees& nees);
 
 }  // namespace mlidar::eval

@@ -29,6 +29,13 @@ Mat6 BaseFrame::covariance_to_base(const Mat6& covariance_reference) const {
   return J * covariance_reference * J.transpose();
 }
 
+Mat6 BaseFrame::covariance_to_reference(const Mat6& covariance_base) const {
+  if (is_reference) return covariance_base;
+  Mat6 J = Mat6::Identity();
+  J.topLeftCorner<3, 3>() = T_base_reference.rotation().toRotationMatrix().transpose();
+  return J * covariance_base * J.transpose();
+}
+
 BaseFrame base_frame(const io::FrameSource& source) {
   BaseFrame frame;
   frame.name = source.dataset_info() ? source.dataset_info()->base : source.lidars().front().name;

@@ -26,6 +26,7 @@ struct BaseFrame {
   SE3 extrinsic_to_base(const SE3& T_reference_lidar) const;
   SE3 extrinsic_to_reference(const SE3& T_base_lidar) const;
   Mat6 covariance_to_base(const Mat6& covariance_reference) const;
+  Mat6 covariance_to_reference(const Mat6& covariance_base) const;  ///< the inverse: J = diag(R_BR^T, I)
   SE3 pose_to_base(const SE3& T_world_reference) const;
   Eigen::Vector3f point_to_base(const Eigen::Vector3f& p_world_reference) const;
 };

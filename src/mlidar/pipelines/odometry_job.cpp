@@ -9,6 +9,7 @@
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/frame_source.hpp"
 #include "mlidar/io/trajectory_io.hpp"
+#include "mlidar/pipelines/given_extrinsics.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/pipelines/slam_config.hpp"
 #include "mlidar/slam/odometry.hpp"
@@ -25,10 +26,21 @@ io::FrameSource open_source(const OdometryJob& job) {
   return io::FrameSource::dataset(job.dataset, job.lidars);
 }
 
-std::vector<slam::LidarSetup> lidar_setups(const io::FrameSource& source) {
+/// The input's LiDARs with their extrinsics (or --extrinsics FILE's); for uncertainty-aware mapping every LiDAR but
+/// the base frame's own gets alpha times the given covariance, else the configured prior (eq 4.24).
+std::vector<slam::LidarSetup> lidar_setups(const OdometryJob& job, const io::FrameSource& source, const SlamConfig& config) {
+  const std::string base = source.dataset_info() ? source.dataset_info()->base : source.lidars().front().name;
+  std::optional<io::Extrinsics> given;
+  if (!job.extrinsics.empty()) given = read_given_extrinsics(job.extrinsics, source, base);
+  if (!job.bag.empty() && job.bag_options.extrinsics && job.bag_options.extrinsics->base == base) given = job.bag_options.extrinsics;
   std::vector<slam::LidarSetup> setups;
-  for (const io::SourceLidar& lidar : source.lidars())
-    setups.push_back({lidar.name, lidar.model, lidar.initial_extrinsic.value_or(SE3::identity())});
+  for (const io::SourceLidar& lidar : source.lidars()) {
+    const io::LidarExtrinsic* from_file = given ? given->find(lidar.name) : nullptr;
+    const SE3 T_base_lidar = from_file && job.bag.empty() ? from_file->T_base_lidar : lidar.initial_extrinsic.value_or(SE3::identity());
+    const std::optional<Mat6> covariance = from_file ? from_file->covariance : std::nullopt;
+    setups.push_back(
+        {lidar.name, lidar.model, T_base_lidar, lidar.name == base ? Mat6::Zero() : extrinsic_doubt(covariance, T_base_lidar, config)});
+  }
   return setups;
 }
 
@@ -76,9 +88,10 @@ std::vector<std::string> front_end_lines(const std::vector<slam::FrameResult>& r
 
 OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<void(int, int)>& progress) {
   if (job.threads < 0) throw UsageError("--threads must be >= 0");
-  const slam::OdometryConfig config = job.config.empty() ? slam::OdometryConfig{} : read_slam_config(job.config).odometry;
+  const SlamConfig slam_config = job.config.empty() ? SlamConfig{} : read_slam_config(job.config);
+  const slam::OdometryConfig& config = slam_config.odometry;
   const io::FrameSource source = open_source(job);
-  const std::vector<slam::LidarSetup> lidars = lidar_setups(source);
+  const std::vector<slam::LidarSetup> lidars = lidar_setups(job, source, slam_config);
   std::unique_ptr<tbb::global_control> threads;
   if (job.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));

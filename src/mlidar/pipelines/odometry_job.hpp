@@ -38,6 +38,9 @@ struct OdometryJob {
   /// `--config`: the same YAML as `mlidar slam --config` (slam_config.hpp);
   /// odometry reads its `odometry` and `selection` sections. Empty: defaults.
   std::filesystem::path config;
+  /// `--extrinsics FILE` with a dataset or clouds: every LiDAR's extrinsic instead of the input's, with the
+  /// covariance that uncertainty-aware mapping gives it (a bag's are in bag_options). Empty: the input's.
+  std::filesystem::path extrinsics;
   std::filesystem::path out;
 };
 

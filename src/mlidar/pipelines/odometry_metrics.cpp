@@ -19,6 +19,22 @@ nlohmann::json timing_summary(std::vector<double> values) {
   return {{"mean", sum / static_cast<double>(values.size())}, {"p50", at(0.5)}, {"p95", at(0.95)}, {"max", values.back()}};
 }
 
+nlohmann::json mapping_json(const std::vector<std::size_t>& lidar_uncertain, const std::optional<slam::MappingReport>& mapping,
+                            const std::vector<std::string>& lidar_names) {
+  if (lidar_uncertain.empty()) return nullptr;
+  nlohmann::json uncertain = nlohmann::json::object();
+  for (std::size_t i = 0; i < lidar_names.size() && i < lidar_uncertain.size(); ++i) uncertain[lidar_names[i]] = lidar_uncertain[i];
+  nlohmann::json json{{"uncertain_features", uncertain}};
+  if (mapping)
+    json["map"] = {{"offered", mapping->features},
+                   {"dropped_uncertain", mapping->dropped_uncertain},
+                   {"added", mapping->points_added},
+                   {"median_trace_m2", mapping->median_trace_m2}};
+  else
+    json["map"] = nullptr;  // not mapped (flagged), or the first frames (mapped again at frame 1)
+  return json;
+}
+
 nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summary, const std::vector<std::string>& lidar_names) {
   if (!summary) return nullptr;
   const slam::SelectionReport& s = summary->report;
@@ -187,7 +203,8 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
                          {"edges", f.edge_features},
                          {"planes", f.plane_features},
                          {"front_end", front_end},
-                         {"selection", selection_json(f.selection_summary(), names)}});
+                         {"selection", selection_json(f.selection_summary(), names)},
+                         {"uncertainty", mapping_json(f.lidar_uncertain, f.mapping, names)}});
   }
   json["total_seconds"] = timing_summary(total);
   json["points_in"] = timing_summary(points_in);
@@ -204,11 +221,28 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   return json;
 }
 
-void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry) {
-  std::vector<Eigen::Vector3f> points = odometry.plane_map().points();
+MapCloud map_cloud(const slam::Odometry& odometry) {
+  MapCloud map{odometry.plane_map().points(), std::nullopt};
   const auto edges = odometry.edge_map().points();
-  points.insert(points.end(), edges.begin(), edges.end());
-  write_map_ply(path, std::move(points));
+  map.points.insert(map.points.end(), edges.begin(), edges.end());
+  if (odometry.config().uncertainty.enabled) {
+    map.covariances.emplace();
+    for (const slam::VoxelMap* part : {&odometry.plane_map(), &odometry.edge_map()})
+      for (const slam::PointCovariance& c : part->covariances()) map.covariances->push_back(c.upper);
+  }
+  return map;
+}
+
+void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry) { write_map_ply(path, map_cloud(odometry)); }
+
+void write_map_ply(const std::filesystem::path& path, const MapCloud& map) {
+  Scan scan;
+  scan.points = map.points;
+  io::CloudFile cloud;
+  cloud.format = io::CloudFormat::kPly;
+  cloud.table = io::from_scan(scan);
+  if (map.covariances) io::add_point_covariances(cloud.table, *map.covariances);
+  io::write_cloud(path, cloud);
 }
 
 void write_map_ply(const std::filesystem::path& path, std::vector<Eigen::Vector3f> points) {

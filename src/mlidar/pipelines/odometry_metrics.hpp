@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mlidar/io/point_covariance_fields.hpp"
 #include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/slam/odometry.hpp"
 
@@ -35,6 +36,10 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
 /// seconds, per_lidar: {NAME: {features, selected}}}. (shared with slam's metrics.json; `selected` is the sum over the LiDARs: the
 /// fallback's all).
 nlohmann::json selection_json(const std::optional<slam::SelectionSummary>& summary, const std::vector<std::string>& lidar_names);
+/// A frame's uncertainty-aware mapping: per LiDAR the features left out for tr(Sigma) > w, and what entered the
+/// map; null when it was off (`lidar_uncertain` empty).
+nlohmann::json mapping_json(const std::vector<std::size_t>& lidar_uncertain, const std::optional<slam::MappingReport>& mapping,
+                            const std::vector<std::string>& lidar_names);
 
 /// The base axis a unit direction lies closest to, in words: "x (forward-backward)",
 /// "y (left-right)" or "z (up-down)" (a degenerate registration's weak translation).
@@ -58,8 +63,17 @@ FrontEndTally front_end_tally(const std::vector<slam::FrameResult>& frames, std:
 /// {mean, p50, p95, max} of `values` (zeros when empty).
 nlohmann::json timing_summary(std::vector<double> values);
 
+/// The odometry's local maps: plane then edge points and, from uncertainty-aware mapping, their covariances.
+struct MapCloud {
+  std::vector<Eigen::Vector3f> points;
+  std::optional<std::vector<io::UpperCovariance>> covariances;  ///< one per point (m^2)
+};
+MapCloud map_cloud(const slam::Odometry& odometry);
+
 /// The odometry's local maps (planes then edges) as a binary PLY, atomically.
 void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry);
+/// A map as a binary PLY with the cov_ fields when it has covariances (io/point_covariance_fields.hpp), atomically.
+void write_map_ply(const std::filesystem::path& path, const MapCloud& map);
 /// Points as a binary PLY, atomically.
 void write_map_ply(const std::filesystem::path& path, std::vector<Eigen::Vector3f> points);
 

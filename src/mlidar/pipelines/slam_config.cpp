@@ -90,7 +90,10 @@ std::vector<Field> initialization_fields(SlamConfig& c) {
        {0, 1e5},
        "frames initializing (and between attempts) before the LiDAR is calibrated by its appearance against the base's map (0: never)",
        &c.start.appearance_after_frames},
-      {"initialization", "appearance_search", {}, "the appearance start searches a start when the refinement from hand-eye's fails",
+      {"initialization",
+       "appearance_search",
+       {},
+       "the appearance start searches a start when the refinement from hand-eye's fails",
        &c.appearance.search},
   };
 }
@@ -184,29 +187,82 @@ std::vector<Field> selection_fields(SlamConfig& c) {
       {"selection", "ratio", {0.0, 1.0, true, false}, "M / N kept in a well-conditioned scene (thesis 0.2)", &sel.ratio},
       {"selection", "adaptive", {}, "keep degenerate_ratio of the features in a degenerate scene (sec 5.4.4)", &sel.adaptive},
       {"selection", "degenerate_ratio", {0.0, 1.0, true, false}, "M / N kept in a degenerate scene (thesis 0.8)", &sel.degenerate_ratio},
-      {"selection", "degeneracy_threshold", {0.0, 1.0}, "degenerate below this translation observability of all features' information",
+      {"selection",
+       "degeneracy_threshold",
+       {0.0, 1.0},
+       "degenerate below this translation observability of all features' information",
        &sel.degeneracy_threshold},
       {"selection", "degeneracy_interval_s", kPositive, "the degeneracy (a search of every feature) is evaluated again after this long",
        &sel.degeneracy_interval_s},
       {"selection", "epsilon", kFraction, "decay factor: each greedy round draws N / M log(1 / epsilon) candidates", &sel.epsilon},
-      {"selection", "time_budget_ms", {0.0, 1e6}, "t_max: stop choosing after this long (0: no limit; a limit is not deterministic)",
+      {"selection",
+       "time_budget_ms",
+       {0.0, 1e6},
+       "t_max: stop choosing after this long (0: no limit; a limit is not deterministic)",
        &sel.time_budget_ms},
       {"selection", "seed", {0, 9007199254740992.0}, "seed of the random draws", &sel.seed},
       {"selection", "min_features", {0, 1e9}, "never keep fewer features than this", &sel.min_features},
-      {"selection", "held_out_share", {0.0, 10.0}, "the result is checked on this share x M of the features it did not use",
+      {"selection",
+       "held_out_share",
+       {0.0, 10.0},
+       "the result is checked on this share x M of the features it did not use",
        &sel.held_out_share},
-      {"selection", "held_out_residual_ratio", {0.0, 1e6}, "they disagree above this x the chosen features' mean |r| (plus the floor)",
+      {"selection",
+       "held_out_residual_ratio",
+       {0.0, 1e6},
+       "they disagree above this x the chosen features' mean |r| (plus the floor)",
        &sel.held_out_residual_ratio},
-      {"selection", "held_out_residual_floor_m", {0.0, 100.0}, "added to that bound (m); disagreeing, every feature is registered",
+      {"selection",
+       "held_out_residual_floor_m",
+       {0.0, 100.0},
+       "added to that bound (m); disagreeing, every feature is registered",
        &sel.held_out_residual_floor_m},
+  };
+}
+
+std::vector<Field> mapping_fields(SlamConfig& c) {
+  slam::UncertaintyConfig& ua = c.odometry.uncertainty;
+  return {
+      {"mapping",
+       "uncertainty_aware",
+       {},
+       "weight registration rows by each point's covariance and keep uncertain points out of the map (sec 4.8)",
+       &ua.enabled},
+      {"mapping",
+       "trace_threshold_m2",
+       {0.0, 1e6, true, false},
+       "w (m^2): points with tr(Sigma) above it do not enter the map",
+       &ua.trace_threshold_m2},
+      {"mapping",
+       "residual_sigma_m",
+       {0.0, 100.0, true, false},
+       "sigma_0 (m): a certain point's residual against the map",
+       &ua.residual_sigma_m},
+      {"mapping", "range_sigma_m", {0.0, 10.0}, "range noise 1-sigma (m) where the LiDAR model gives none", &ua.range_sigma_m},
+      {"mapping", "angular_sigma_rad", {0.0, 0.1}, "bearing noise 1-sigma (rad) per axis", &ua.angular_sigma_rad},
+      {"mapping",
+       "voxel_filter_m",
+       {0.0, 100.0},
+       "eq 4.30 cube edge (m) for a frame's points before they enter the map (0: off)",
+       &ua.voxel_filter_m},
+      {"mapping",
+       "extrinsic_prior_translation_m",
+       {0.0, 100.0},
+       "extrinsic 1-sigma (m) per axis where the extrinsics input has no covariance (before alpha)",
+       &c.mapping.extrinsic_prior_translation_m},
+      {"mapping",
+       "extrinsic_prior_rotation_deg",
+       {0.0, 180.0},
+       "extrinsic 1-sigma (deg) per axis where the extrinsics input has no covariance (before alpha)",
+       &c.mapping.extrinsic_prior_rotation_deg},
   };
 }
 
 /// The schema: one row per key, bound to `c`'s members, section by section.
 std::vector<Field> fields(SlamConfig& c) {
   std::vector<Field> all;
-  for (auto* section : {&initialization_fields, &convergence_fields, &window_fields, &shock_fields, &odometry_fields,
-                        &selection_fields}) {
+  for (auto* section :
+       {&initialization_fields, &convergence_fields, &window_fields, &shock_fields, &odometry_fields, &selection_fields, &mapping_fields}) {
     const std::vector<Field> rows = section(c);
     all.insert(all.end(), rows.begin(), rows.end());
   }

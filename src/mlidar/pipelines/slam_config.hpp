@@ -43,6 +43,13 @@ struct StartParams {
   std::size_t appearance_after_frames = 100;
 };
 
+/// Uncertainty-aware mapping's inputs beyond slam::UncertaintyConfig: the extrinsic covariance used where the
+/// extrinsics input gives none (1-sigma per axis, before alpha).
+struct MappingParams {
+  double extrinsic_prior_translation_m = 0.01;
+  double extrinsic_prior_rotation_deg = 0.04;
+};
+
 struct SlamConfig {
   /// Eq 4.15-4.18; measured defaults beyond the thesis: the translation's predicted std gate and the planar start.
   calib::OnlineHandEyeConfig initialization{.translation_max_std_m = 0.1, .planar_rotation = true, .planar_min_pairs = 30};
@@ -55,7 +62,8 @@ struct SlamConfig {
   /// Re-calibration trigger; a rise below 2x is not a shock: a sustained 1.45-1.76x rise of one LiDAR's residual
   /// ratio in part of the simulated room fired a false trigger (43 m protocol, room seed 6), Table 4.6's shock is 6x.
   calib::ShockDetectorConfig shock{.min_relative_jump = 1.0};
-  slam::OdometryConfig odometry;  ///< front end and scan-to-map registration
+  slam::OdometryConfig odometry;  ///< front end and scan-to-map registration; odometry.uncertainty is `mapping:`
+  MappingParams mapping;
 };
 
 /// One documented key: "section.key", its allowed range in words, its meaning.

@@ -117,6 +117,10 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   out.selection = last_odometry_.selection_summary();
   if (out.selection)
     for (const slam::LidarSetup& lidar : odometry_->lidars()) out.selection_lidars.push_back(lidar.name);
+  out.uncertain_features = last_odometry_.lidar_uncertain;
+  out.mapping = last_odometry_.mapping;
+  if (!out.uncertain_features.empty())
+    for (const slam::LidarSetup& lidar : odometry_->lidars()) out.uncertainty_lidars.push_back(lidar.name);
   out.seconds.odometry = seconds_since(start);
   if (pose_window_) {
     start = Clock::now();
@@ -151,13 +155,6 @@ std::vector<SlamLidarReport> SlamEstimator::lidar_reports(std::span<const SlamFr
 
 std::vector<slam::WindowPose> SlamEstimator::unsettled_poses() const {
   return pose_window_ ? pose_window_->unsettled() : std::vector<slam::WindowPose>{};
-}
-
-std::vector<Eigen::Vector3f> SlamEstimator::map_points() const {
-  std::vector<Eigen::Vector3f> points = odometry_->plane_map().points();
-  const std::vector<Eigen::Vector3f> edges = odometry_->edge_map().points();
-  points.insert(points.end(), edges.begin(), edges.end());
-  return points;
 }
 
 }  // namespace mlidar::pipelines

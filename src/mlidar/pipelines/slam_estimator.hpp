@@ -55,7 +55,7 @@ class SlamEstimator {
   /// window.refine_odometry: the frames whose pose has not settled yet, at their latest estimates.
   std::vector<slam::WindowPose> unsettled_poses() const;
   /// The current local maps (planes then edges) in the world frame.
-  std::vector<Eigen::Vector3f> map_points() const;
+  const slam::Odometry& trusted_odometry() const { return *odometry_; }
   /// LiDAR j's state (for tests and reports).
   const LidarTrack& track(std::size_t j) const { return tracks_.at(j); }
 

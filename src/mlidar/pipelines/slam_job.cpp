@@ -6,6 +6,7 @@
 
 #include <tbb/global_control.h>
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/covariance.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
@@ -14,6 +15,7 @@
 #include "mlidar/io/frame_source.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/pipelines/base_frame.hpp"
+#include "mlidar/pipelines/given_extrinsics.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/pipelines/slam_metrics.hpp"
 
@@ -33,13 +35,60 @@ std::vector<std::size_t> estimator_order(const io::FrameSource& source) {
   return order;
 }
 
-/// The estimator's LiDARs, their given extrinsics relative to the reference LiDAR.
-std::vector<slam::LidarSetup> estimator_setups(const io::FrameSource& source, const std::vector<std::size_t>& order,
-                                               const BaseFrame& frame) {
+/// The map in the dataset's base frame B: p_B = T_B_R p_R, Sigma_B = R_BR Sigma_R R_BR^T.
+MapCloud map_in_base(MapCloud map, const BaseFrame& frame) {
+  if (frame.is_reference) return map;
+  for (Eigen::Vector3f& p : map.points) p = frame.point_to_base(p);
+  if (map.covariances) {
+    const Mat3 R = frame.T_base_reference.rotation_matrix();
+    for (io::UpperCovariance& c : *map.covariances) {
+      Mat3 m;
+      m << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
+      const Mat3 r = R * m * R.transpose();
+      c = {static_cast<float>(r(0, 0)), static_cast<float>(r(0, 1)), static_cast<float>(r(0, 2)),
+           static_cast<float>(r(1, 1)), static_cast<float>(r(1, 2)), static_cast<float>(r(2, 2))};
+    }
+  }
+  return map;
+}
+
+/// --extrinsics FILE with a dataset: every LiDAR of the source in it, relative to the dataset's base frame. With a
+/// bag the source already took the file's extrinsics (io/bag_frames.hpp); its covariances count when they are
+/// relative to the frame the job estimates in.
+std::optional<io::Extrinsics> given_extrinsics(const SlamJob& job, const io::FrameSource& source, const BaseFrame& frame) {
+  if (!job.bag.empty()) {
+    if (!job.bag_options.extrinsics || job.bag_options.extrinsics->base != frame.name) return std::nullopt;
+    io::Extrinsics given = *job.bag_options.extrinsics;
+    for (io::LidarExtrinsic& lidar : given.lidars)
+      for (const io::SourceLidar& read : source.lidars())
+        if (read.name == lidar.name && read.initial_extrinsic) lidar.T_base_lidar = *read.initial_extrinsic;
+    return given;
+  }
+  if (job.extrinsics.empty()) return std::nullopt;
+  return read_given_extrinsics(job.extrinsics, source, frame.name);
+}
+
+/// Eq 4.24's alpha Xi of a given extrinsic as the odometry uses it (left perturbation, reference LiDAR frame):
+/// the file's covariance, else the configured prior; zero for the reference LiDAR itself.
+Mat6 given_extrinsic_covariance(const std::optional<Mat6>& covariance_base, const SE3& T_reference_lidar, bool is_reference,
+                                const BaseFrame& frame, const SlamConfig& config) {
+  if (is_reference) return Mat6::Zero();
+  const Mat6 local = covariance_base ? frame.covariance_to_reference(*covariance_base) : extrinsic_prior_covariance(config);
+  return covariance_in_left_tangent(T_reference_lidar, config.window.extrinsic_covariance_scale * local);
+}
+
+/// The estimator's LiDARs, their given extrinsics (the dataset's or --extrinsics FILE's) relative to the reference LiDAR.
+std::vector<slam::LidarSetup> estimator_setups(const io::FrameSource& source, const std::vector<std::size_t>& order, const BaseFrame& frame,
+                                               const std::optional<io::Extrinsics>& given, const SlamConfig& config) {
   std::vector<slam::LidarSetup> setups;
   for (const std::size_t i : order) {
     const io::SourceLidar& lidar = source.lidars()[i];
-    setups.push_back({lidar.name, lidar.model, frame.extrinsic_to_reference(lidar.initial_extrinsic.value_or(frame.T_base_reference))});
+    const io::LidarExtrinsic* from_file = given ? given->find(lidar.name) : nullptr;
+    const SE3 T_base_lidar = from_file ? from_file->T_base_lidar : lidar.initial_extrinsic.value_or(frame.T_base_reference);
+    const SE3 T_reference_lidar = frame.extrinsic_to_reference(T_base_lidar);
+    const std::optional<Mat6> covariance = from_file ? from_file->covariance : std::nullopt;
+    setups.push_back({lidar.name, lidar.model, T_reference_lidar,
+                      given_extrinsic_covariance(covariance, T_reference_lidar, i == frame.reference, frame, config)});
   }
   return setups;
 }
@@ -143,7 +192,8 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
 
   const BaseFrame frame = base_frame(source);
-  SlamEstimator estimator(config, estimator_setups(source, order, frame), job.calibrate);
+  const std::optional<io::Extrinsics> given = given_extrinsics(job, source, frame);
+  SlamEstimator estimator(config, estimator_setups(source, order, frame, given, config), job.calibrate);
   FrameGaps gaps(source);
   const SlamRun run = run_frames(source, order, estimator, gaps, progress);
   SlamJobSummary summary = summarize(run, estimator, order, gaps, job, frame);
@@ -154,9 +204,7 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
   io::write_pose_covariances(job.out / "pose_covariance.txt", covariances);
   if (!covariances.empty()) summary.last_pose_covariance = covariances.back().covariance;
   write_extrinsics_file(job.out / "extrinsics.yaml", frame, summary.lidars);
-  std::vector<Eigen::Vector3f> map = estimator.map_points();
-  for (Eigen::Vector3f& p : map) p = frame.point_to_base(p);
-  write_map_ply(job.out / "map.ply", std::move(map));
+  write_map_ply(job.out / "map.ply", map_in_base(map_cloud(estimator.trusted_odometry()), frame));
   nlohmann::json metrics = slam_metrics_json(run.frames, order, summary.lidars, run.load_seconds, to_string(job.calibrate));
   add_pose_covariance_traces(metrics, covariances);
   metrics["skipped_scans"] = gaps.json();

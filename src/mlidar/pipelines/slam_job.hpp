@@ -31,6 +31,9 @@ struct SlamJob {
   io::BagSourceOptions bag_options;  ///< its topics, base, extrinsics, models
   std::filesystem::path dataset;
   std::filesystem::path config;  ///< mloam.yaml, or empty for the defaults (Table 4.2)
+  /// extrinsics.yaml to use instead of the dataset's initial extrinsics (with --calibrate fixed or refine), its
+  /// covariances the extrinsic doubt of uncertainty-aware mapping; empty: the dataset's.
+  std::filesystem::path extrinsics;
   ExtrinsicSource calibrate = ExtrinsicSource::online;
   int threads = 0;                             ///< 0 = TBB's default
   double max_base_gaps = kDefaultMaxBaseGaps;  ///< share of frames the base LiDAR may lack a usable scan in

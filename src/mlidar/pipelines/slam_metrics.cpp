@@ -98,42 +98,41 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
   const Vec3 t = l.T_base_lidar.translation();
   nlohmann::json covariance = nullptr;
   if (l.covariance) covariance = std::vector<double>(l.covariance->data(), l.covariance->data() + 36);  // symmetric: order irrelevant
-  return {
-      {"role", std::string(to_string(l.role))},
-      {"translation", {t.x(), t.y(), t.z()}},
-      {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-      {"covariance", covariance},
-      {"covariance_terms", covariance_terms_json(l.covariance_parts)},
-      {"initialization",
-       {{"state", std::string(calib::to_string(init.state))},
-        {"frame", optional_json(l.initialized_frame)},
-        {"pairs_stored", init.pairs_stored},
-        {"pairs_seen", init.pairs_seen},
-        {"singular_values", init.singular_values},
-        {"translation_eigenvalues", init.translation_eigenvalues},
-        {"rotation_rms_rad", init.rotation_rms_rad},
-        {"planar_motion", init.planar_motion},
-        {"pairs_translation", init.pairs_translation},
-        {"translation_std_m", number_or_null(init.translation_std_m)},
-        {"planar_rotation", init.planar_rotation},
-        {"translation_start",
-         l.translation_start == TranslationStart::none ? nlohmann::json(nullptr) : nlohmann::json(to_string(l.translation_start))},
-        {"unobservable_from_motion", l.unobservable_from_motion},
-        {"axis_translation_source", l.axis_translation_source == AxisTranslationSource::none
-                                        ? nlohmann::json(nullptr)
-                                        : nlohmann::json(to_string(l.axis_translation_source))},
-        {"observable_in_window", l.unobservable_from_motion.empty() ? nlohmann::json(nullptr) : nlohmann::json(window_observed(l))},
-        {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}},
-        {"appearance", appearance_json(l.appearance_attempts)}}},
-      {"converged_frame", optional_json(l.converged_frame)},
-      {"first_converged_frame", optional_json(l.first_converged_frame)},
-      {"accepted", l.accepted},
-      {"outlier_windows", l.outliers},
-      {"restarts", l.restarts},
-      {"shock_frames", l.shock_frames},
-      {"reinitialization_frames", l.reinitialization_frames},
-      {"missing_frames", l.missing_frames},
-      {"weak_directions", weak}};
+  return {{"role", std::string(to_string(l.role))},
+          {"translation", {t.x(), t.y(), t.z()}},
+          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+          {"covariance", covariance},
+          {"covariance_terms", covariance_terms_json(l.covariance_parts)},
+          {"initialization",
+           {{"state", std::string(calib::to_string(init.state))},
+            {"frame", optional_json(l.initialized_frame)},
+            {"pairs_stored", init.pairs_stored},
+            {"pairs_seen", init.pairs_seen},
+            {"singular_values", init.singular_values},
+            {"translation_eigenvalues", init.translation_eigenvalues},
+            {"rotation_rms_rad", init.rotation_rms_rad},
+            {"planar_motion", init.planar_motion},
+            {"pairs_translation", init.pairs_translation},
+            {"translation_std_m", number_or_null(init.translation_std_m)},
+            {"planar_rotation", init.planar_rotation},
+            {"translation_start",
+             l.translation_start == TranslationStart::none ? nlohmann::json(nullptr) : nlohmann::json(to_string(l.translation_start))},
+            {"unobservable_from_motion", l.unobservable_from_motion},
+            {"axis_translation_source", l.axis_translation_source == AxisTranslationSource::none
+                                            ? nlohmann::json(nullptr)
+                                            : nlohmann::json(to_string(l.axis_translation_source))},
+            {"observable_in_window", l.unobservable_from_motion.empty() ? nlohmann::json(nullptr) : nlohmann::json(window_observed(l))},
+            {"unobservable_axis_base", {init.unobservable_axis_base.x(), init.unobservable_axis_base.y(), init.unobservable_axis_base.z()}},
+            {"appearance", appearance_json(l.appearance_attempts)}}},
+          {"converged_frame", optional_json(l.converged_frame)},
+          {"first_converged_frame", optional_json(l.first_converged_frame)},
+          {"accepted", l.accepted},
+          {"outlier_windows", l.outliers},
+          {"restarts", l.restarts},
+          {"shock_frames", l.shock_frames},
+          {"reinitialization_frames", l.reinitialization_frames},
+          {"missing_frames", l.missing_frames},
+          {"weak_directions", weak}};
 }
 
 }  // namespace
@@ -166,12 +165,14 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
                          {"trusted_changed", f.trusted_changed},
                          {"lidars", per_lidar},
                          {"selection", selection_json(f.selection, f.selection_lidars)},
-                         {"seconds", {{"load", i < load_seconds.size() ? load_seconds[i] : 0.0},
-                                      {"odometry", f.seconds.odometry},
-                                      {"initialization", f.seconds.initialization},
-                                      {"calibration", f.seconds.calibration},
-                                      {"shock", f.seconds.shock},
-                                      {"window", f.seconds.window}}}});
+                         {"uncertainty", mapping_json(f.uncertain_features, f.mapping, f.uncertainty_lidars)},
+                         {"seconds",
+                          {{"load", i < load_seconds.size() ? load_seconds[i] : 0.0},
+                           {"odometry", f.seconds.odometry},
+                           {"initialization", f.seconds.initialization},
+                           {"calibration", f.seconds.calibration},
+                           {"shock", f.seconds.shock},
+                           {"window", f.seconds.window}}}});
   }
   json["lost_frames"] = lost;
   json["suspect_frames"] = suspect;

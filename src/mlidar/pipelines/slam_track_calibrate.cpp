@@ -6,6 +6,8 @@
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/pipelines/slam_lidar_track.hpp"
 
+#include "mlidar/core/covariance.hpp"
+
 namespace mlidar::pipelines {
 namespace {
 
@@ -66,7 +68,9 @@ TrackTransition LidarTrack::calibrate(Calibrating& state, const TrackFrame& fram
     // Algorithm 1 lines 8-11: the mean of L_calib accepted estimates, covariance alpha Xi_calib.
     const calib::LidarCalibrationState& converged = monitor_.lidar(0);
     setup_.T_base_lidar = converged.T_base_lidar;
-    state_ = Trusted{config_->window.extrinsic_covariance_scale * converged.covariance, converged.covariance_parts};
+    const Mat6 scaled = config_->window.extrinsic_covariance_scale * converged.covariance;
+    setup_.extrinsic_covariance = covariance_in_left_tangent(converged.T_base_lidar, scaled);  // eq 4.24 for the mapping
+    state_ = Trusted{scaled, converged.covariance_parts};
     return TrackTransition::converged;
   }
   if (!stays_far_from_the_map(state, frame, out)) return TrackTransition::none;

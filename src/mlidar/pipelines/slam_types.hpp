@@ -70,6 +70,11 @@ struct SlamFrame {
   /// The trusted odometry's feature selection (none when off), for the LiDARs it registered (selection_lidars).
   std::optional<slam::SelectionSummary> selection;
   std::vector<std::string> selection_lidars;
+  /// Uncertainty-aware mapping (empty / none when off): per LiDAR of the trusted odometry (`uncertainty_lidars`) the
+  /// features too uncertain to register, and what entered the map.
+  std::vector<std::size_t> uncertain_features;
+  std::vector<std::string> uncertainty_lidars;
+  std::optional<slam::MappingReport> mapping;
 };
 
 /// Where the calibration window's translation started at the last hand-eye start.

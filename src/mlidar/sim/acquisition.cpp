@@ -66,6 +66,10 @@ SimulatedScan simulate_sweep(const Scene& scene, const SimLidar& lidar, const Si
       out.scan.ring.push_back(static_cast<std::uint16_t>(ring));
       out.scan.time.push_back(static_cast<float>(t_rel));
       out.object_id.push_back(hit->object_id);
+      if (hit->object_id < 0) {
+        out.scenery_hits.push_back(ray.origin + hit->t * ray.direction);
+        out.scenery_normals.push_back(hit->normal);
+      }
     }
   }
   return out;

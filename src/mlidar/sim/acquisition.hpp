@@ -23,6 +23,9 @@ namespace mlidar::sim {
 struct SimulatedScan {
   Scan scan;                   ///< stamp = frame stamp; time = seconds from it
   std::vector<int> object_id;  ///< per point: labelled object hit, or -1
+  /// The exact (noise-free) hits on unlabelled scenery, world frame, with the surface's unit normal there.
+  std::vector<Vec3> scenery_hits;
+  std::vector<Vec3> scenery_normals;
 };
 
 /// Simulates the sweep of `lidar` for the frame stamped `frame_stamp`.

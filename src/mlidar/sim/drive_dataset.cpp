@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -14,10 +15,12 @@
 #include "mlidar/io/extrinsics_io.hpp"
 #include "mlidar/io/kitti.hpp"
 #include "mlidar/io/pcd.hpp"
+#include "mlidar/io/surface_samples.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/sim/acquisition.hpp"
 #include "mlidar/sim/ground_truth.hpp"
 #include "mlidar/sim/scenes.hpp"
+#include "mlidar/sim/surface_sampler.hpp"
 
 namespace mlidar::sim {
 namespace {
@@ -48,7 +51,8 @@ io::Dataset describe(const DriveSpec& spec) {
   dataset.frame_period = spec.rig.frame_period();
   dataset.base = spec.rig.base_frame;
   // A base frame that is no LiDAR (lyft's vehicle) is placed by the first LiDAR, whose extrinsic is given exactly.
-  const bool base_is_lidar = std::any_of(spec.rig.lidars.begin(), spec.rig.lidars.end(), [&](const auto& l) { return l.name == dataset.base; });
+  const bool base_is_lidar =
+      std::any_of(spec.rig.lidars.begin(), spec.rig.lidars.end(), [&](const auto& l) { return l.name == dataset.base; });
   if (!base_is_lidar) dataset.reference_lidar = spec.rig.lidars.front().name;
   std::mt19937_64 rng(spec.seed ^ 0x7065727475726221ULL);
   for (const auto& lidar : spec.rig.lidars) {
@@ -113,12 +117,16 @@ void write_drive_dataset(const DriveSpec& spec, const fs::path& out, const Progr
 
   Trajectory truth;
   std::vector<double> stamps;
+  std::optional<SurfaceSampler> surfaces;
+  if (spec.surface_spacing_m > 0.0) surfaces.emplace(spec.surface_spacing_m, spec.trajectory.T_world_base(start).inverse());
   for (int frame = 0; frame < spec.frames; ++frame) {
     const double stamp = start + period * frame;
     std::set<int> seen;
     for (std::size_t i = 0; i < spec.rig.lidars.size(); ++i) {
       const SimLidar& lidar = spec.rig.lidars[i];
       const auto sweep = simulate_sweep(scene, lidar, spec.trajectory, stamp, sweep_seed(spec.seed, static_cast<std::uint64_t>(frame), i));
+      if (surfaces)
+        for (std::size_t k = 0; k < sweep.scenery_hits.size(); ++k) surfaces->add(sweep.scenery_hits[k], sweep.scenery_normals[k]);
       for (const int id : sweep.object_id) {
         if (id > 0) seen.insert(id);
       }
@@ -134,6 +142,7 @@ void write_drive_dataset(const DriveSpec& spec, const fs::path& out, const Progr
     if (progress) progress(frame + 1, spec.frames);
   }
   io::write_tum(dir / "groundtruth" / "trajectory.tum", truth);
+  if (surfaces) io::write_surface_samples(dir / "groundtruth" / "surfaces.ply", surfaces->samples());
   io::write_extrinsics(dir / "groundtruth" / "extrinsics.yaml", true_extrinsics(spec.rig));
   io::write_times(dir / "times.txt", stamps);
   io::write_dataset_yaml(dir / "dataset.yaml", dataset);

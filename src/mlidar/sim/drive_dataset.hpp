@@ -5,7 +5,8 @@
 //   intensity ring t, t = seconds from the frame stamp, points in the LiDAR
 //   frame at their firing time), groundtruth/trajectory.tum (T_world_base at
 //   each stamp), groundtruth/extrinsics.yaml (true T_base_lidar),
-//   groundtruth/boxes/ (scenes with labelled objects; see ground_truth.hpp).
+//   groundtruth/boxes/ (scenes with labelled objects; see ground_truth.hpp),
+//   groundtruth/surfaces.ply (with DriveSpec::surface_spacing_m).
 // Frame k is stamped start + k * frame_period. The same spec and seed give
 // byte-identical files.
 #include <cstdint>
@@ -32,6 +33,9 @@ struct DriveSpec {
   double perturb_m = 0.0;
   /// The scans' PCD encoding (binary_compressed: about a third smaller, a little slower to write and read).
   io::PcdEncoding encoding = io::PcdEncoding::kBinary;
+  /// > 0: also groundtruth/surfaces.ply, the scenery's exact hits one per cube of this edge (m), in the frame of the
+  /// base at the first frame (the frame a run's map.ply is in), with normals (sim/surface_sampler.hpp).
+  double surface_spacing_m = 0.0;
 };
 
 /// Called after each frame with (frames done, total).

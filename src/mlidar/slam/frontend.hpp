@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "mlidar/core/se3.hpp"
 #include "mlidar/core/types.hpp"
 #include "mlidar/slam/deskew.hpp"
 #include "mlidar/slam/features.hpp"
@@ -46,6 +47,9 @@ struct LidarSetup {
   std::string name;
   LidarModel model;  ///< vertical_angles_deg may be empty (fallback)
   SE3 T_base_lidar;
+  /// alpha Xi of T_base_lidar (eq 4.24): left perturbation, base frame, [t, r]; zero for the base or a certain one.
+  /// Used by uncertainty-aware mapping only (OdometryConfig::uncertainty).
+  Mat6 extrinsic_covariance = Mat6::Zero();
 };
 
 /// Features of one LiDAR in the base frame at the reference stamp given to run_front_end.

@@ -12,6 +12,8 @@
 #include <tbb/parallel_for.h>
 
 #include "mlidar/core/conversions.hpp"
+#include "mlidar/core/median.hpp"
+#include "mlidar/slam/pose_covariance.hpp"
 
 namespace mlidar::slam {
 namespace {
@@ -148,16 +150,87 @@ BodyVelocity Odometry::latest_velocity() const {
   return BodyVelocity::from_relative_pose(a.T_world_base.inverse() * b.T_world_base, b.stamp - a.stamp);
 }
 
-void Odometry::update_map(const SE3& T_world_centroid, const LidarFeatures& features) {
-  std::vector<Eigen::Vector3f> world;
-  append_transformed(T_world_centroid, features.edges, world);
-  edge_map_.add(world);
-  world.clear();
-  append_transformed(T_world_centroid, features.planes, world);
-  plane_map_.add(world);
+namespace {
+
+/// World points and covariances of one block's features (eq 4.29 through the LiDAR's compounded world pose).
+void append_covariant(const UncertainPose& T_world_lidar, const SE3& T_lidar_base, const SE3& T_world_base,
+                      std::span<const Eigen::Vector3f> points_base, double range_sigma_m, double angular_sigma_rad,
+                      std::vector<CovariantPoint>& out) {
+  for (const Eigen::Vector3f& p : points_base) {
+    const Vec3 p_base = p.cast<double>();
+    const Vec3 p_lidar = T_lidar_base * p_base;
+    const Mat3 Z = lidar_point_noise(p_lidar, range_sigma_m, angular_sigma_rad);
+    out.push_back({(T_world_base * p_base).cast<float>(), PointCovariance::from(point_covariance(T_world_lidar, p_lidar, Z))});
+  }
+}
+
+/// Drops the points with tr(Sigma) > w (sec 4.8.2) and returns how many it dropped; adds every offered trace to `traces`.
+std::size_t drop_uncertain(double trace_threshold_m2, std::vector<CovariantPoint>& points, std::vector<double>& traces) {
+  const std::size_t before = points.size();
+  for (const CovariantPoint& p : points) traces.push_back(p.covariance.trace());
+  std::erase_if(points, [&](const CovariantPoint& p) { return !(p.covariance.trace() <= trace_threshold_m2); });
+  return before - points.size();
+}
+
+void add_covariant(const std::vector<CovariantPoint>& points, VoxelMap& map) {
+  std::vector<Eigen::Vector3f> xyz;
+  std::vector<PointCovariance> covariances;
+  xyz.reserve(points.size());
+  covariances.reserve(points.size());
+  for (const CovariantPoint& p : points) {
+    xyz.push_back(p.point);
+    covariances.push_back(p.covariance);
+  }
+  map.add(xyz, covariances);
+}
+
+}  // namespace
+
+std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, const LidarFeatures& features,
+                                                  const std::vector<FeatureBlock>& blocks, const Mat6& Xi_reg) {
+  std::optional<MappingReport> report;
+  const UncertaintyConfig& ua = config_.uncertainty;
+  if (!ua.enabled) {
+    std::vector<Eigen::Vector3f> world;
+    append_transformed(T_world_centroid, features.edges, world);
+    edge_map_.add(world);
+    world.clear();
+    append_transformed(T_world_centroid, features.planes, world);
+    plane_map_.add(world);
+  } else {
+    // Sec 4.8.1-4.8.2: each LiDAR's world pose compounded (fourth order), each point's Sigma, tr(Sigma) <= w, eq 4.30.
+    std::vector<CovariantPoint> edges, planes;
+    std::size_t edge_at = 0, plane_at = 0;
+    for (const FeatureBlock& block : blocks) {
+      const UncertainPose T_world_lidar = compound({T_world_centroid, Xi_reg}, block.T_base_lidar);
+      const SE3 T_lidar_base = block.T_base_lidar.T.inverse();
+      append_covariant(T_world_lidar, T_lidar_base, T_world_centroid, std::span(features.edges).subspan(edge_at, block.edges),
+                       block.range_sigma_m, ua.angular_sigma_rad, edges);
+      append_covariant(T_world_lidar, T_lidar_base, T_world_centroid, std::span(features.planes).subspan(plane_at, block.planes),
+                       block.range_sigma_m, ua.angular_sigma_rad, planes);
+      edge_at += block.edges;
+      plane_at += block.planes;
+    }
+    if (edge_at != features.edges.size() || plane_at != features.planes.size())
+      throw std::logic_error("Odometry::update_map: feature blocks do not cover the features");
+    report.emplace();
+    report->features = edges.size() + planes.size();
+    std::vector<double> traces;
+    report->dropped_uncertain =
+        drop_uncertain(ua.trace_threshold_m2, edges, traces) + drop_uncertain(ua.trace_threshold_m2, planes, traces);
+    report->median_trace_m2 = traces.empty() ? 0.0 : median(traces);
+    if (ua.voxel_filter_m > 0.0) {
+      edges = covariance_voxel_filter(edges, ua.voxel_filter_m, ua.trace_threshold_m2);
+      planes = covariance_voxel_filter(planes, ua.voxel_filter_m, ua.trace_threshold_m2);
+    }
+    report->points_added = edges.size() + planes.size();
+    add_covariant(edges, edge_map_);
+    add_covariant(planes, plane_map_);
+  }
   const Eigen::Vector3f origin = T_world_centroid.translation().cast<float>();
   edge_map_.remove_far(origin, config_.local_map_radius_m);
   plane_map_.remove_far(origin, config_.local_map_radius_m);
+  return report;
 }
 
 void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_unmapped) {
@@ -167,11 +240,13 @@ void Odometry::restart_with_first_velocity(double first_centroid_time, bool seco
   for (auto& pose : centroid_poses_) pose.T_world_base = T_stamp_centroid * pose.T_world_base;
   edge_map_ = VoxelMap(config_.edge_voxel_m, config_.edge_points_per_voxel);
   plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);
+  // The first frame defines the world (no pose doubt); the second is registered against it alone, its
+  // pose doubt left out too.
   deskew_again(velocity, first_features_);
-  update_map(centroid_poses_.front().T_world_base, first_features_);
+  update_map(centroid_poses_.front().T_world_base, first_features_, first_blocks_, Mat6::Zero());
   if (!second_unmapped) {
     deskew_again(velocity, frame_features_);
-    update_map(centroid_poses_.back().T_world_base, frame_features_);
+    update_map(centroid_poses_.back().T_world_base, frame_features_, frame_blocks_, Mat6::Zero());
   }
   clear_features(first_features_);
 }
@@ -218,8 +293,9 @@ void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, Fr
       BodyVelocity::from_relative_pose(previous.T_world_base.inverse() * result.registration.T_world_base, centroid_stamp - previous.stamp);
   redeskew(frame_features_.edge_times, used, measured, frame_features_.edges);
   redeskew(frame_features_.plane_times, used, measured, frame_features_.planes);
-  result.registration = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_,
-                                             result.registration.T_world_base, result.threshold_m, registration_);
+  result.registration =
+      register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, result.registration.T_world_base,
+                           result.threshold_m, registration_, nullptr, query_covariances());
 }
 
 void Odometry::apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered) {
@@ -252,10 +328,11 @@ void Odometry::add_retries(const SE3& prediction, double threshold, const Motion
   out.resize(first + starts.size());
   tbb::parallel_for(std::size_t{0}, starts.size(), [&](std::size_t i) {
     // A coarse pass with the initial (wide) threshold, then a fine pass.
-    const RegistrationResult coarse = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, starts[i],
-                                                           std::max(threshold, config_.initial_threshold_m), every_feature);
+    const RegistrationResult coarse =
+        register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, starts[i],
+                             std::max(threshold, config_.initial_threshold_m), every_feature, nullptr, query_covariances());
     out[first + i] = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base,
-                                          threshold, every_feature, motion);
+                                          threshold, every_feature, motion, query_covariances());
   });
 }
 
@@ -270,7 +347,7 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, double cen
   frame.recent_residual_m = rule.recent_median_m;
   std::vector<RegistrationResult> candidates;
   candidates.push_back(register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold,
-                                            registration_, motion));
+                                            registration_, motion, query_covariances()));
   // After a long gap the constant-velocity prediction says little, and one
   // alignment that fits is no evidence that it is the only one: the retries
   // run and decide, rivals included.
@@ -286,6 +363,81 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, double cen
   const Choice choice = choose_registration(candidates, rule);
   frame.trust = judge_degenerate_correction(choice.trust, candidates[choice.best], prediction, config_.trust);
   return std::move(candidates[choice.best]);
+}
+
+namespace {
+
+/// Keeps the entries of `values` whose `keep` is true (times may be empty: nothing to filter).
+template <typename T>
+void keep_where(const std::vector<bool>& keep, std::vector<T>& values) {
+  if (values.empty()) return;
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (keep[i]) values[out++] = values[i];
+  values.resize(out);
+}
+
+/// One LiDAR's features with tr(Sigma_b) <= w (their covariances alongside); returns how many it dropped.
+std::size_t drop_uncertain_features(double trace_threshold_m2, LidarFeatures& f, std::vector<PointCovariance>& edge_covariances,
+                                    std::vector<PointCovariance>& plane_covariances) {
+  const auto certain = [&](const std::vector<PointCovariance>& covariances) {
+    std::vector<bool> keep(covariances.size());
+    for (std::size_t i = 0; i < covariances.size(); ++i) keep[i] = covariances[i].trace() <= trace_threshold_m2;
+    return keep;
+  };
+  const std::size_t before = f.edges.size() + f.planes.size();
+  const std::vector<bool> keep_edges = certain(edge_covariances), keep_planes = certain(plane_covariances);
+  // The voxel samples are the last of the planes.
+  f.voxel_samples =
+      static_cast<std::size_t>(std::count(keep_planes.end() - static_cast<std::ptrdiff_t>(f.voxel_samples), keep_planes.end(), true));
+  keep_where(keep_edges, f.edges);
+  keep_where(keep_edges, f.edge_times);
+  keep_where(keep_edges, edge_covariances);
+  keep_where(keep_planes, f.planes);
+  keep_where(keep_planes, f.plane_times);
+  keep_where(keep_planes, plane_covariances);
+  return before - f.edges.size() - f.planes.size();
+}
+
+}  // namespace
+
+void Odometry::collect_features(FrameResult& result) {
+  clear_features(frame_features_);
+  frame_blocks_.clear();
+  const UncertaintyConfig& ua = config_.uncertainty;
+  std::vector<std::vector<PointCovariance>> edge_covariances(lidars_.size()), plane_covariances(lidars_.size());
+  if (ua.enabled) {
+    // Eq 4.29 in the base frame for every feature (extrinsic and sensor noise; the base pose is what is solved for);
+    // those with tr(Sigma) > w are left out of the registration and the map (sec 4.8.2).
+    result.lidar_uncertain.assign(lidars_.size(), 0);
+    tbb::parallel_for(std::size_t{0}, lidars_.size(), [&](std::size_t i) {
+      const double range_sigma_m = lidars_[i].model.range_noise_sigma > 0.0 ? lidars_[i].model.range_noise_sigma : ua.range_sigma_m;
+      const UncertainPose T_base_lidar{lidars_[i].T_base_lidar, lidars_[i].extrinsic_covariance};
+      edge_covariances[i] = feature_covariances(features_[i].edges, T_base_lidar, range_sigma_m, ua.angular_sigma_rad);
+      plane_covariances[i] = feature_covariances(features_[i].planes, T_base_lidar, range_sigma_m, ua.angular_sigma_rad);
+      result.lidar_uncertain[i] = drop_uncertain_features(ua.trace_threshold_m2, features_[i], edge_covariances[i], plane_covariances[i]);
+    });
+  }
+  for (std::size_t i = 0; i < lidars_.size(); ++i) {
+    result.lidar_features.push_back(features_[i].edges.size() + features_[i].planes.size());
+    result.lidar_rows.push_back(features_[i].rows);
+    result.lidar_row_source.push_back(features_[i].row_source);
+    append_features(features_[i], frame_features_);
+    const double range_sigma_m = lidars_[i].model.range_noise_sigma > 0.0 ? lidars_[i].model.range_noise_sigma : ua.range_sigma_m;
+    frame_blocks_.push_back({features_[i].edges.size(), features_[i].planes.size(),
+                             UncertainPose{lidars_[i].T_base_lidar, lidars_[i].extrinsic_covariance}, range_sigma_m});
+  }
+  result.edge_features = frame_features_.edges.size();
+  result.plane_features = frame_features_.planes.size();
+  query_covariances_.reset();
+  if (!ua.enabled) return;
+  edge_covariances_.clear();
+  plane_covariances_.clear();
+  for (std::size_t i = 0; i < lidars_.size(); ++i) {
+    edge_covariances_.insert(edge_covariances_.end(), edge_covariances[i].begin(), edge_covariances[i].end());
+    plane_covariances_.insert(plane_covariances_.end(), plane_covariances[i].begin(), plane_covariances[i].end());
+  }
+  query_covariances_ = QueryCovariances{edge_covariances_, plane_covariances_, ua.residual_sigma_m};
 }
 
 FrameResult Odometry::process(const Frame& frame) {
@@ -304,17 +456,11 @@ FrameResult Odometry::process(const Frame& frame) {
   tbb::parallel_for(std::size_t{0}, lidars_.size(), [&](std::size_t i) {
     run_front_end(frame.scans[i], centroid_stamp, lidars_[i], velocity, config_.front_end, workspaces_[i], features_[i], per_lidar[i]);
   });
-  clear_features(frame_features_);
   for (std::size_t i = 0; i < lidars_.size(); ++i) {
     for (std::size_t s = 0; s < kStageCount; ++s) result.seconds[s] += per_lidar[i][s];
     result.points_in += frame.scans[i].size();
-    result.lidar_features.push_back(features_[i].edges.size() + features_[i].planes.size());
-    result.lidar_rows.push_back(features_[i].rows);
-    result.lidar_row_source.push_back(features_[i].row_source);
-    append_features(features_[i], frame_features_);
   }
-  result.edge_features = frame_features_.edges.size();
-  result.plane_features = frame_features_.planes.size();
+  collect_features(result);
 
   auto start = std::chrono::steady_clock::now();
   SE3 T_world_centroid = SE3::identity();
@@ -346,13 +492,20 @@ FrameResult Odometry::process(const Frame& frame) {
     // No velocity yet: the first frame is mapped undeskewed and deskewed again once frame 2 gives one.
     first_stamp_ = frame.stamp;
     first_features_ = frame_features_;
+    first_blocks_ = frame_blocks_;
   }
   centroid_poses_.push_back({centroid_stamp, T_world_centroid});
   if (centroid_poses_.size() == 2) {
     restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.flagged());
     result.registration.T_world_base = centroid_poses_.back().T_world_base;
   } else if (result.trust == Trust::kTrusted) {
-    update_map(T_world_centroid, frame_features_);
+    // The first frame defines the world: no pose doubt.
+    const bool registered = centroid_poses_.size() > 1;
+    const Mat6 Xi_reg = config_.uncertainty.enabled && registered
+                            ? registration_covariance(result.registration.hessian, registration_residual_variance(result.registration),
+                                                      result.registration.weak_translation, MotionPriorSigma{})
+                            : Mat6::Zero();
+    result.mapping = update_map(T_world_centroid, frame_features_, frame_blocks_, Xi_reg);
   }
   // Every registered frame, suspect ones too: a lasting change of the fit (a rougher scene) moves the
   // median within half the history instead of leaving every later frame suspect and the map frozen.

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "mlidar/slam/frontend.hpp"
+#include "mlidar/slam/point_uncertainty.hpp"
 #include "mlidar/slam/registration_trust.hpp"
 #include "mlidar/slam/scan_to_map.hpp"
 #include "mlidar/slam/voxel_map.hpp"
@@ -76,6 +77,17 @@ struct OdometryConfig {
   /// and map them with the last one: the prediction's velocity is a frame late
   /// (ATE -20 to -45 % on the handheld protocol for +5 % CPU: docs/benchmarks.md).
   bool deskew_in_registration = true;
+  /// Uncertainty-aware mapping (thesis sec 4.8, point_uncertainty.hpp): registration rows weighted by each
+  /// feature's covariance, map points with theirs, uncertain ones left out. Off by default.
+  UncertaintyConfig uncertainty;
+};
+
+/// What a mapped frame added to the map under uncertainty-aware mapping (FrameResult::mapping).
+struct MappingReport {
+  std::size_t features = 0;           ///< features offered to the map
+  std::size_t dropped_uncertain = 0;  ///< of those, with tr(Sigma) > w
+  std::size_t points_added = 0;       ///< after eq 4.30's filter (== features - dropped without it)
+  double median_trace_m2 = 0.0;       ///< of the offered features' tr(Sigma)
 };
 
 /// A frame's feature selection as the metrics report it (FrameResult::selection_summary).
@@ -115,6 +127,8 @@ struct FrameResult {
   /// (RegistrationResult::selection) how many of them the registration chose.
   std::vector<std::size_t> lidar_features;
   std::vector<std::size_t> lidar_selected;
+  /// With uncertainty-aware mapping, per LiDAR: features left out (before lidar_features) for tr(Sigma) > w in the base frame.
+  std::vector<std::size_t> lidar_uncertain;
   /// Per LiDAR (construction order): its range image's rows (0: voxel fallback) and where they came from.
   std::vector<int> lidar_rows;
   std::vector<RowSource> lidar_row_source;
@@ -124,6 +138,8 @@ struct FrameResult {
   bool degenerate_scene = false;
   /// The above with the registration's report; none when it selected no features.
   std::optional<SelectionSummary> selection_summary() const;
+  /// With uncertainty-aware mapping, for a frame whose features entered the map.
+  std::optional<MappingReport> mapping;
 };
 
 class Odometry {
@@ -142,6 +158,7 @@ class Odometry {
   const VoxelMap& plane_map() const { return plane_map_; }
   const VoxelMap& edge_map() const { return edge_map_; }
   const std::vector<LidarSetup>& lidars() const { return lidars_; }
+  const OdometryConfig& config() const { return config_; }
   /// The last frame's features per LiDAR (construction order), in the base
   /// frame at that frame's time centroid, i.e. at FrameResult::registration.T_world_base.
   const std::vector<LidarFeatures>& lidar_features() const { return features_; }
@@ -162,7 +179,19 @@ class Odometry {
   void add_retries(const SE3& prediction, double threshold, const MotionDeskew* motion, std::vector<RegistrationResult>& out) const;
   void refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result);
   void adapt_threshold(const SE3& prediction, const SE3& estimate);
-  void update_map(const SE3& T_world_centroid, const LidarFeatures& features);
+  /// Features of several LiDARs concatenated (edges, then planes, LiDAR after LiDAR): how many of each.
+  struct FeatureBlock {
+    std::size_t edges = 0, planes = 0;
+    UncertainPose T_base_lidar;  ///< the extrinsic and alpha Xi it was seen through
+    double range_sigma_m = 0.0;
+  };
+  /// The current frame's features per LiDAR and, with uncertainty-aware mapping, their base-frame covariances.
+  void collect_features(FrameResult& result);
+  /// The registrations' QueryCovariances (nullptr without uncertainty-aware mapping).
+  const QueryCovariances* query_covariances() const { return query_covariances_ ? &*query_covariances_ : nullptr; }
+  /// `Xi_reg`: the registration's covariance (left, world) that uncertainty-aware mapping propagates.
+  std::optional<MappingReport> update_map(const SE3& T_world_centroid, const LidarFeatures& features,
+                                          const std::vector<FeatureBlock>& blocks, const Mat6& Xi_reg);
   /// At the second frame, once a velocity is known: moves the world from the
   /// first frame's centroid pose to its stamp pose and rebuilds the map from
   /// the first two frames' features deskewed with that velocity.
@@ -174,6 +203,9 @@ class Odometry {
   std::vector<LidarFeatures> features_;
   LidarFeatures frame_features_;  ///< all LiDARs' features of the current frame
   LidarFeatures first_features_;  ///< the first frame's, kept until the second frame
+  std::vector<FeatureBlock> frame_blocks_, first_blocks_;
+  std::vector<PointCovariance> edge_covariances_, plane_covariances_;  ///< of frame_features_, base frame (UA only)
+  std::optional<QueryCovariances> query_covariances_;
   VoxelMap edge_map_;
   VoxelMap plane_map_;
   std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <optional>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -84,6 +85,16 @@ struct Matcher {
   std::span<float> residuals;  ///< |r| per query (edges, then planes), NaN when unmatched
   /// When screening for feature selection: each query's weighted rows (rank 0: unmatched); else empty.
   std::span<FeatureInformation> information;
+  /// Eq 4.23: each query's covariance (base frame) and sigma_0^2; empty: unweighted.
+  std::span<const PointCovariance> edge_covariances = {};
+  std::span<const PointCovariance> plane_covariances = {};
+  double residual_sigma_sq = 0.0;
+
+  /// The uncertainty weight of query i's row with world normal n (1 without covariances).
+  double uncertainty(std::span<const PointCovariance> covariances, std::size_t i, const Vec3& n_world) const {
+    if (covariances.empty()) return 1.0;
+    return uncertainty_weight(covariances[i], T.rotation().conjugate() * n_world, residual_sigma_sq);
+  }
 
   template <typename Model, typename Search>
   const std::optional<Model>& lookup(CachedMatch<Model>& cached, const Vec3& q, Search search) const {
@@ -104,7 +115,7 @@ struct Matcher {
     const PlaneRow row = plane_row(*plane, q);
     const double norm = std::abs(row.residual);
     if (norm > max_residual_m) return;
-    const double w = huber_weight(norm, huber_delta);
+    const double w = huber_weight(norm, huber_delta) * uncertainty(plane_covariances, i, plane->normal);
     eq.add(row, w);
     eq.residual_sum += norm;
     residuals[cache.edges.size() + i] = static_cast<float>(norm);
@@ -123,11 +134,13 @@ struct Matcher {
     const double norm = std::hypot(first.residual, second.residual);
     if (norm > max_residual_m) return;
     const double w = huber_weight(norm, huber_delta);
-    eq.add(first, w);
-    eq.add(second, w);
+    const double w_first = w * uncertainty(edge_covariances, i, planes.first.normal);
+    const double w_second = w * uncertainty(edge_covariances, i, planes.second.normal);
+    eq.add(first, w_first);
+    eq.add(second, w_second);
     eq.residual_sum += norm;
     residuals[i] = static_cast<float>(norm);
-    if (!information.empty()) information[i] = rank_two(std::sqrt(w) * first.jacobian, std::sqrt(w) * second.jacobian);
+    if (!information.empty()) information[i] = rank_two(std::sqrt(w_first) * first.jacobian, std::sqrt(w_second) * second.jacobian);
     ++eq.edges;
   }
 };
@@ -179,6 +192,8 @@ struct WorkingSet {
   std::vector<float> edge_times_owned, plane_times_owned;
   std::span<const Eigen::Vector3f> edges, planes;
   std::span<const float> edge_times, plane_times;  ///< with MotionDeskew only
+  std::vector<PointCovariance> edge_covariances_owned, plane_covariances_owned;
+  std::span<const PointCovariance> edge_covariances, plane_covariances;  ///< with QueryCovariances only
   MatchCache cache;
   /// For a subset: each feature's position among the input queries (edges, then planes); empty: the input itself.
   std::vector<std::uint32_t> positions;
@@ -190,10 +205,17 @@ struct WorkingSet {
   }
 };
 
-WorkingSet whole_input(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const MotionDeskew* motion) {
+WorkingSet whole_input(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const MotionDeskew* motion,
+                       const QueryCovariances* covariances) {
   WorkingSet set;
   set.edges = edges;
   set.planes = planes;
+  if (covariances != nullptr) {
+    if (covariances->edges.size() != edges.size() || covariances->planes.size() != planes.size())
+      throw std::invalid_argument("register_scan_to_map: one covariance per feature");
+    set.edge_covariances = covariances->edges;
+    set.plane_covariances = covariances->planes;
+  }
   if (motion != nullptr) {
     set.edges_owned.assign(edges.begin(), edges.end());
     set.planes_owned.assign(planes.begin(), planes.end());
@@ -210,20 +232,25 @@ WorkingSet chosen_subset(const WorkingSet& all, std::span<const std::uint32_t> c
   WorkingSet set;
   const std::size_t edge_count = all.edges.size();
   const bool timed = !all.edge_times.empty() || !all.plane_times.empty();
+  const bool weighted = !all.edge_covariances.empty() || !all.plane_covariances.empty();
   for (const std::uint32_t position : chosen) {
     if (position < edge_count) {
       set.edges_owned.push_back(all.edges[position]);
       set.cache.edges.push_back(all.cache.edges[position]);
       if (timed) set.edge_times_owned.push_back(all.edge_times[position]);
+      if (weighted) set.edge_covariances_owned.push_back(all.edge_covariances[position]);
     } else {
       set.planes_owned.push_back(all.planes[position - edge_count]);
       set.cache.planes.push_back(all.cache.planes[position - edge_count]);
       if (timed) set.plane_times_owned.push_back(all.plane_times[position - edge_count]);
+      if (weighted) set.plane_covariances_owned.push_back(all.plane_covariances[position - edge_count]);
     }
   }
   set.point_at_owned();
   set.edge_times = set.edge_times_owned;
   set.plane_times = set.plane_times_owned;
+  set.edge_covariances = set.edge_covariances_owned;
+  set.plane_covariances = set.plane_covariances_owned;
   set.positions.assign(chosen.begin(), chosen.end());
   return set;
 }
@@ -293,7 +320,8 @@ SelectionReport choose_features(const Matcher& matcher, const WorkingSet& set, c
 /// first those that matched at the start like the chosen, then unsearched
 /// ones; never one that had no correspondence at the start.
 WorkingSet held_out_sample(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const MotionDeskew* motion,
-                           const RegistrationResult& result, std::span<const StartMatch> start, const SelectionConfig& config) {
+                           const QueryCovariances* covariances, const RegistrationResult& result, std::span<const StartMatch> start,
+                           const SelectionConfig& config) {
   const SelectionReport& report = *result.selection;
   std::vector<bool> chosen(result.queries, false);
   for (const std::uint32_t i : report.chosen) chosen[i] = true;
@@ -315,7 +343,7 @@ WorkingSet held_out_sample(std::span<const Eigen::Vector3f> edges, std::span<con
   std::vector<std::uint32_t> others = matched;
   others.insert(others.end(), unsearched.begin(), unsearched.end());
   std::sort(others.begin(), others.end());
-  WorkingSet sample = chosen_subset(whole_input(edges, planes, motion), others);
+  WorkingSet sample = chosen_subset(whole_input(edges, planes, motion, covariances), others);
   if (motion != nullptr && result.velocity_used) {
     redeskew(sample.edge_times, motion->used, *result.velocity_used, sample.edges_owned);
     redeskew(sample.plane_times, motion->used, *result.velocity_used, sample.planes_owned);
@@ -356,9 +384,10 @@ std::vector<float> residuals_at_queries(std::span<const float> subset, std::span
 
 RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_in, std::span<const Eigen::Vector3f> planes_in,
                                         const VoxelMap& edge_map, const VoxelMap& plane_map, const SE3& initial,
-                                        double max_correspondence_m, const RegistrationConfig& config, const MotionDeskew* motion) {
+                                        double max_correspondence_m, const RegistrationConfig& config, const MotionDeskew* motion,
+                                        const QueryCovariances* covariances) {
   // With a MotionDeskew the features are copied and deskewed again as the estimate moves.
-  WorkingSet set = whole_input(edges_in, planes_in, motion);
+  WorkingSet set = whole_input(edges_in, planes_in, motion, covariances);
   RegistrationResult result;
   if (motion != nullptr) result.velocity_used = motion->used;
   result.T_world_base = initial;
@@ -366,11 +395,24 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_i
   result.residuals_m.assign(result.queries, std::numeric_limits<float>::quiet_NaN());
   const float search_sq = neighborhood_sq(max_correspondence_m, config);
   const double rematch_sq = config.rematch_distance_m * config.rematch_distance_m;
-  const auto matcher_with = [&](MatchCache& cache, std::span<float> residuals) {
-    return Matcher{edge_map,   plane_map, result.T_world_base, config, search_sq, max_correspondence_m, config.huber_delta_m,
-                   rematch_sq, cache,     residuals,           {}};
+  const double residual_sigma_sq = covariances == nullptr ? 0.0 : covariances->residual_sigma_m * covariances->residual_sigma_m;
+  const auto matcher_with = [&](WorkingSet& features, std::span<float> residuals) {
+    return Matcher{edge_map,
+                   plane_map,
+                   result.T_world_base,
+                   config,
+                   search_sq,
+                   max_correspondence_m,
+                   config.huber_delta_m,
+                   rematch_sq,
+                   features.cache,
+                   residuals,
+                   {},
+                   features.edge_covariances,
+                   features.plane_covariances,
+                   residual_sigma_sq};
   };
-  const auto matcher_for = [&](std::span<float> residuals) { return matcher_with(set.cache, residuals); };
+  const auto matcher_for = [&](std::span<float> residuals) { return matcher_with(set, residuals); };
   // Thesis Algorithm 2 at the start pose (x_check); the iterations then see only the chosen features.
   std::vector<float> subset_residuals;
   std::vector<StartMatch> start_matches;
@@ -413,15 +455,15 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_i
   }
   if (result.selection) {
     result.residuals_m = residuals_at_queries(subset_residuals, set.positions, result.queries);
-    WorkingSet sample = held_out_sample(edges_in, planes_in, motion, result, start_matches, config.selection);
+    WorkingSet sample = held_out_sample(edges_in, planes_in, motion, covariances, result, start_matches, config.selection);
     std::vector<float> sample_residuals(sample.size());
-    const NormalEquations fit = linearise(sample.edges, sample.planes, matcher_with(sample.cache, sample_residuals));
+    const NormalEquations fit = linearise(sample.edges, sample.planes, matcher_with(sample, sample_residuals));
     if (!solved || !held_out_agrees(fit, sample.size(), config.selection, result)) {
       // The chosen features settled where the others do not fit: the full set decides.
       RegistrationConfig every_feature = config;
       every_feature.selection.method = SelectionMethod::kNone;
       return with_fallback_report(
-          register_scan_to_map(edges_in, planes_in, edge_map, plane_map, initial, max_correspondence_m, every_feature, motion),
+          register_scan_to_map(edges_in, planes_in, edge_map, plane_map, initial, max_correspondence_m, every_feature, motion, covariances),
           std::move(*result.selection));
     }
   }
@@ -433,7 +475,7 @@ RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_i
 
 Degeneracy full_set_degeneracy(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const VoxelMap& edge_map,
                                const VoxelMap& plane_map, const SE3& pose, double max_correspondence_m, const RegistrationConfig& config) {
-  WorkingSet set = whole_input(edges, planes, nullptr);
+  WorkingSet set = whole_input(edges, planes, nullptr, nullptr);
   std::vector<float> residuals(set.size());
   std::vector<FeatureInformation> information(set.size());
   for (FeatureInformation& f : information) f.rank = 0;

@@ -31,6 +31,7 @@
 #include "mlidar/core/se3.hpp"
 #include "mlidar/slam/deskew.hpp"
 #include "mlidar/slam/feature_selection.hpp"
+#include "mlidar/slam/point_uncertainty.hpp"
 #include "mlidar/slam/voxel_map.hpp"
 
 namespace mlidar::slam {
@@ -124,19 +125,27 @@ struct MotionDeskew {
   BodyVelocity used;                   ///< the velocity the features were deskewed with
 };
 
+/// Eq 4.23's Sigma_p of each query in the base frame (point_uncertainty.hpp): each plane row is weighted by
+/// uncertainty_weight on top of its Huber weight (also in the hessian and the selection's information).
+struct QueryCovariances {
+  std::span<const PointCovariance> edges;   ///< one per edge feature
+  std::span<const PointCovariance> planes;  ///< one per plane feature
+  double residual_sigma_m = 0.05;           ///< sigma_0
+};
+
 /// max_correspondence_m bounds the residual of a correspondence (and is the least search radius).
 /// With `motion`, the features are deskewed again between iterations and
 /// `velocity_used` of the result holds the velocity of the last deskew.
+/// With `covariances`, the rows are weighted by the queries' uncertainty (eq 4.23).
 RegistrationResult register_scan_to_map(std::span<const Eigen::Vector3f> edges_base, std::span<const Eigen::Vector3f> planes_base,
                                         const VoxelMap& edge_map, const VoxelMap& plane_map, const SE3& initial,
-                                        double max_correspondence_m, const RegistrationConfig& config,
-                                        const MotionDeskew* motion = nullptr);
+                                        double max_correspondence_m, const RegistrationConfig& config, const MotionDeskew* motion = nullptr,
+                                        const QueryCovariances* covariances = nullptr);
 
 /// The degeneracy factors (thesis sec 5.4.4, feature_selection.hpp) of the
 /// information of every feature that has a correspondence at `pose`; one
 /// search per feature.
 Degeneracy full_set_degeneracy(std::span<const Eigen::Vector3f> edges, std::span<const Eigen::Vector3f> planes, const VoxelMap& edge_map,
-                                const VoxelMap& plane_map, const SE3& pose, double max_correspondence_m, const RegistrationConfig& config);
-
+                               const VoxelMap& plane_map, const SE3& pose, double max_correspondence_m, const RegistrationConfig& config);
 
 }  // namespace mlidar::slam

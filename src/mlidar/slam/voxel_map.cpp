@@ -25,10 +25,27 @@ void VoxelMap::add(std::span<const Eigen::Vector3f> points) {
   }
 }
 
+void VoxelMap::add(std::span<const Eigen::Vector3f> points, std::span<const PointCovariance> covariances) {
+  if (points.size() != covariances.size()) throw std::invalid_argument("VoxelMap::add: one covariance per point");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite()) continue;
+    const VoxelKey key = key_of(p);
+    auto& bucket = map_[key];
+    if (static_cast<int>(bucket.size()) >= max_points_) continue;
+    if (bucket.empty()) bucket.reserve(static_cast<std::size_t>(max_points_));
+    auto& kept = covariances_[key];
+    kept.resize(bucket.size());  // points added without a covariance before this one: zero
+    bucket.push_back(p);
+    kept.push_back(covariances[i]);
+  }
+}
+
 void VoxelMap::remove_far(const Eigen::Vector3f& origin, double max_distance) {
   const float limit_sq = static_cast<float>(max_distance * max_distance);
   for (auto it = map_.begin(); it != map_.end();) {
     if ((it->second.front() - origin).squaredNorm() > limit_sq) {
+      covariances_.erase(it->first);
       it = map_.erase(it);
     } else {
       ++it;
@@ -110,6 +127,17 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
 std::vector<Eigen::Vector3f> VoxelMap::points() const {
   std::vector<Eigen::Vector3f> all;
   for (const auto& [key, bucket] : map_) all.insert(all.end(), bucket.begin(), bucket.end());
+  return all;
+}
+
+std::vector<PointCovariance> VoxelMap::covariances() const {
+  std::vector<PointCovariance> all;
+  for (const auto& [key, bucket] : map_) {
+    const auto it = covariances_.find(key);
+    const std::size_t begin = all.size();
+    if (it != covariances_.end()) all.insert(all.end(), it->second.begin(), it->second.end());
+    all.resize(begin + bucket.size());
+  }
   return all;
 }
 

@@ -12,6 +12,8 @@
 #include <tsl/robin_map.h>
 #include <Eigen/Core>
 
+#include "mlidar/slam/point_uncertainty.hpp"
+
 namespace mlidar::slam {
 
 struct VoxelKey {
@@ -37,6 +39,8 @@ class VoxelMap {
 
   /// Adds world points; a full voxel ignores new points.
   void add(std::span<const Eigen::Vector3f> points);
+  /// The same with each point's covariance (same length; uncertainty-aware mapping), kept for covariances().
+  void add(std::span<const Eigen::Vector3f> points, std::span<const PointCovariance> covariances);
   /// Drops voxels whose first point lies farther than max_distance from origin.
   void remove_far(const Eigen::Vector3f& origin, double max_distance);
 
@@ -46,6 +50,8 @@ class VoxelMap {
   int nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, std::array<Eigen::Vector3f, kMaxNeighbors>& out) const;
 
   std::vector<Eigen::Vector3f> points() const;
+  /// Each point of points() (same order): its covariance, zero for a point added without one.
+  std::vector<PointCovariance> covariances() const;
   std::size_t voxels() const { return map_.size(); }
   bool empty() const { return map_.empty(); }
   double voxel_size() const { return voxel_size_; }
@@ -56,6 +62,9 @@ class VoxelMap {
   double voxel_size_;
   int max_points_;
   tsl::robin_map<VoxelKey, std::vector<Eigen::Vector3f>, VoxelKeyHash> map_;
+  /// Per voxel, the covariances of its first points (a prefix of the bucket's; the rest are zero); only voxels
+  /// that received a point with one.
+  tsl::robin_map<VoxelKey, std::vector<PointCovariance>, VoxelKeyHash> covariances_;
 };
 
 }  // namespace mlidar::slam
