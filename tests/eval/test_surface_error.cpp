@@ -35,6 +35,7 @@ TEST(SurfaceError, DistanceAlongTheNormalAndItsNormalizedErrorByHand) {
   EXPECT_EQ(error.matched, 2u);  // 0.9 m above the floor: not matched
   EXPECT_NEAR(error.distance_m.mean, 0.04, 1e-6);
   EXPECT_NEAR(error.distance_m.max, 0.06, 1e-6);
+  EXPECT_NEAR(error.signed_mean_m, -0.02, 1e-6);  // (0.02 - 0.06) / 2
   ASSERT_TRUE(error.normalized.has_value());
   EXPECT_EQ(error.normalized->count, 2u);
   EXPECT_NEAR(error.normalized->mean, -0.5, 1e-4);

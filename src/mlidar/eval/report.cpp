@@ -151,13 +151,15 @@ nlohmann::json to_json(const SurfaceError& error, const SurfaceErrorOptions& opt
           {"matched", error.matched},
           {"max_distance_m", options.max_distance_m},
           {"distance_m", to_json(error.distance_m)},
+          {"signed_mean_m", number_or_null(error.signed_mean_m)},
           {"normalized_error", normalized}};
 }
 
 std::string format_table(const SurfaceError& error, const SurfaceErrorOptions& options) {
   std::string text = "distance to the true surfaces: " + std::to_string(error.matched) + " of " + std::to_string(error.points) +
                      " points within " + fixed(options.max_distance_m, 2) + " m; |distance| mean " + fixed(error.distance_m.mean, 4) +
-                     " m, rmse " + fixed(error.distance_m.rmse, 4) + " m, max " + fixed(error.distance_m.max, 4) + " m\n";
+                     " m, rmse " + fixed(error.distance_m.rmse, 4) + " m, max " + fixed(error.distance_m.max, 4) + " m, signed mean " +
+                     fixed(error.signed_mean_m, 4) + " m\n";
   if (!error.normalized) return text + "normalized error: the map has no point covariances\n";
   return text + "normalized error along the normal: variance " + fixed(error.normalized->variance, 3) +
          " (1 when the covariances are honest), mean " + fixed(error.normalized->mean, 3) + ", " +

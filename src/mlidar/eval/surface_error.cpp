@@ -27,6 +27,7 @@ SurfaceError surface_error(const std::vector<Eigen::Vector3f>& points, const std
     const Eigen::Vector3d n = surfaces.normals[nearest.front().index].cast<double>();
     const double d = n.dot(points[i].cast<double>() - q);
     distances.push_back(std::abs(d));
+    out.signed_mean_m += d;
     if (!covariances) continue;
     const io::UpperCovariance& c = (*covariances)[i];
     Eigen::Matrix3d sigma;
@@ -40,6 +41,7 @@ SurfaceError surface_error(const std::vector<Eigen::Vector3f>& points, const std
     normalized.inside_95 += std::abs(e) <= 1.959964 ? 1.0 : 0.0;
   }
   out.matched = distances.size();
+  out.signed_mean_m = out.matched > 0 ? out.signed_mean_m / static_cast<double>(out.matched) : std::nan("");
   out.distance_m = summarize(std::move(distances));
   if (covariances) {
     if (normalized.count > 0) {

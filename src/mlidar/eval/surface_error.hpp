@@ -28,9 +28,10 @@ struct NormalizedSurfaceError {
 };
 
 struct SurfaceError {
-  std::size_t points = 0;                            ///< map points given
-  std::size_t matched = 0;                           ///< within max_distance_m of a sample
-  ErrorStats distance_m;                             ///< |n^T (p - q)| of the matched points
+  std::size_t points = 0;      ///< map points given
+  std::size_t matched = 0;     ///< within max_distance_m of a sample
+  ErrorStats distance_m;       ///< |n^T (p - q)| of the matched points
+  double signed_mean_m = 0.0;  ///< mean of n^T (p - q), n facing the sensor that saw the sample: < 0 behind the surface
   std::optional<NormalizedSurfaceError> normalized;  ///< when covariances are given
 };
 
