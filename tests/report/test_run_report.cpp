@@ -13,6 +13,7 @@
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/cloud_file.hpp"
+#include "mlidar/io/point_covariance_fields.hpp"
 #include "mlidar/io/point_table.hpp"
 #include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/trajectory_io.hpp"
@@ -165,6 +166,35 @@ TEST(RunReport, HasTheSectionsItsDataAllowWithVerdictsInWords) {
   EXPECT_EQ(html.find("http"), std::string::npos) << "nothing to fetch, no namespace URL either";
   EXPECT_EQ(html.find("<script"), std::string::npos);
   EXPECT_EQ(render_report_html(load_run(f.run)), html) << "the same folder gives the same bytes";
+}
+
+TEST(RunReport, AMapWithCovariancesIsAlsoDrawnByItsTrace) {
+  const Fixture f = make_run(true);
+  EXPECT_EQ(section(render_report_html(load_run(f.run)), "map").find("covariance trace"), std::string::npos) << "no covariances, no view";
+  // A 10 x 4 m floor certain to 1e-4 m^2 and a far strip at x = 9-10 m uncertain to 1e-2 m^2.
+  Scan map;
+  std::vector<io::UpperCovariance> covariances;
+  for (int i = 0; i <= 100; ++i)
+    for (int j = 0; j <= 40; ++j) {
+      map.points.emplace_back(0.1f * i, 0.1f * j, 0.0f);
+      const float variance = i > 90 ? 1e-2F / 3 : 1e-4F / 3;
+      covariances.push_back({variance, 0.0F, 0.0F, variance, 0.0F, variance});
+    }
+  io::CloudFile cloud{io::CloudFormat::kPly, "binary_little_endian", {0, 0, 0, 1, 0, 0, 0}, io::from_scan(map)};
+  io::add_point_covariances(cloud.table, covariances);
+  fs::remove(f.run / "map.ply");
+  io::write_cloud(f.run / "map.ply", cloud);
+  const RunData run = load_run(f.run);
+  ASSERT_EQ(run.map_traces.size(), map.points.size());
+  EXPECT_NEAR(run.map_traces.back(), 1e-2, 1e-7);
+  const std::string view = section(render_report_html(run), "map");
+  const std::size_t words = view.find("largest tr(&Sigma;) in them"), at = view.find("largest point covariance trace");
+  ASSERT_NE(words, std::string::npos);
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_NE(view.find("from 0.0001 m&sup2;", words), std::string::npos) << view.substr(words, 400);
+  EXPECT_NE(view.find("to 0.01 m&sup2;", words), std::string::npos);
+  EXPECT_NE(view.find("fill=\"#440154\"", at), std::string::npos) << "the certain floor: the bottom of the scale";
+  EXPECT_NE(view.find("fill=\"#fde725\"", at), std::string::npos) << "the uncertain strip: the top of the scale";
 }
 
 TEST(RunReport, WithoutGroundTruthItSaysSoAndStillRenders) {

@@ -1,10 +1,13 @@
 // The map section of report.html: map.ply seen from above, each cell of a
 // grid coloured by the highest point in it (heights clipped to the 2nd-98th
-// percentile so a few stray points do not wash out the colours).
+// percentile so a few stray points do not wash out the colours); when the map
+// carries point covariances, a second view coloured by the largest tr(Sigma)
+// in each cell (log scale, clipped likewise).
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 
 #include "mlidar/report/report_sections.hpp"
@@ -37,21 +40,14 @@ double percentile(std::vector<float> values, double share) {
   return values[k];
 }
 
-}  // namespace
-
-std::optional<Section> map_section(const RunData& run) {
-  std::vector<Eigen::Vector3f> points;
-  for (const Eigen::Vector3f& p : run.map)
-    if (p.allFinite()) points.push_back(p);
-  if (points.size() < 10) return std::nullopt;
+/// The cells of a grid over `points` (x, y), each holding the largest `values` of its points mapped through
+/// `level` (t in [0, 1]) onto the colour scale.
+Raster top_view(const std::vector<Eigen::Vector3f>& points, const std::vector<float>& values, const std::function<double(float)>& level) {
   Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
-  std::vector<float> heights;
   for (const Eigen::Vector3f& p : points) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
-    heights.push_back(p.z());
   }
-  const double z_lo = percentile(heights, 0.02), z_hi = std::max(percentile(heights, 0.98), z_lo + 1e-3);
   Raster raster;
   raster.cell = std::max(static_cast<double>(std::max(hi.x() - lo.x(), hi.y() - lo.y())) / kLongSideCells, 0.05);
   raster.x0 = lo.x();
@@ -59,20 +55,23 @@ std::optional<Section> map_section(const RunData& run) {
   raster.columns = static_cast<int>(std::floor((hi.x() - lo.x()) / raster.cell)) + 1;
   raster.rows = static_cast<int>(std::floor((hi.y() - lo.y()) / raster.cell)) + 1;
   std::vector<float> top(static_cast<std::size_t>(raster.columns) * raster.rows, -std::numeric_limits<float>::infinity());
-  for (const Eigen::Vector3f& p : points) {
-    const int c = std::min(raster.columns - 1, static_cast<int>((p.x() - raster.x0) / raster.cell));
-    const int r = std::min(raster.rows - 1, static_cast<int>((p.y() - raster.y0) / raster.cell));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const int c = std::min(raster.columns - 1, static_cast<int>((points[i].x() - raster.x0) / raster.cell));
+    const int r = std::min(raster.rows - 1, static_cast<int>((points[i].y() - raster.y0) / raster.cell));
     float& cell = top[static_cast<std::size_t>(r) * raster.columns + c];
-    cell = std::max(cell, p.z());
+    cell = std::max(cell, values[i]);
   }
   raster.colours.resize(top.size());
   for (std::size_t i = 0; i < top.size(); ++i) {
     if (!std::isfinite(top[i])) continue;
-    const double t = (top[i] - z_lo) / (z_hi - z_lo);
-    raster.colours[i] = height_colour(std::round(std::clamp(t, 0.0, 1.0) * (kColourLevels - 1)) / (kColourLevels - 1));
+    raster.colours[i] = height_colour(std::round(std::clamp(level(top[i]), 0.0, 1.0) * (kColourLevels - 1)) / (kColourLevels - 1));
   }
+  return raster;
+}
+
+Chart top_view_chart(std::string title, Raster raster, const RunData& run) {
   Chart chart;
-  chart.title = "Map, top view (highest point per cell)";
+  chart.title = std::move(title);
   chart.x_label = "x (m)";
   chart.y_label = "y (m)";
   chart.equal_axes = true;
@@ -87,10 +86,42 @@ std::optional<Section> map_section(const RunData& run) {
     }
     chart.series.push_back(std::move(path));
   }
-  const std::string html =
-      "<p>map.ply, " + std::to_string(points.size()) + " points in the frame of trajectory.tum (drawn in red); cells of " +
-      fixed(chart.raster.cell, 2) + " m coloured by height from " + fixed(z_lo, 2) + " m (<span style=\"color:" + height_colour(0.0) +
-      "\">dark blue</span>) to " + fixed(z_hi, 2) + " m (<span style=\"color:#b8a000\">yellow</span>).</p>\n" + render_svg(chart);
+  return chart;
+}
+
+/// The second view: each cell's largest tr(Sigma), log10 between the 2nd and 98th percentile.
+std::string trace_view(const RunData& run) {
+  std::vector<float> logs;
+  for (const float trace : run.map_traces) logs.push_back(std::log10(std::max(trace, 1e-12F)));
+  const double lo = percentile(logs, 0.02), hi = std::max(percentile(logs, 0.98), lo + 1e-3);
+  const Chart chart = top_view_chart("Map, top view (largest point covariance trace per cell)",
+                                     top_view(run.map, logs, [&](float v) { return (v - lo) / (hi - lo); }), run);
+  char range[96];
+  std::snprintf(range, sizeof range, "from %.2g m&sup2; (<span style=\"color:%s\">dark blue</span>) to %.2g m&sup2;", std::pow(10.0, lo),
+                height_colour(0.0).c_str(), std::pow(10.0, hi));
+  return "<p>Each point's position covariance &Sigma; (uncertainty-aware mapping): cells coloured by the largest tr(&Sigma;) in them, " +
+         std::string(range) +
+         " (<span style=\"color:#b8a000\">yellow</span>), log scale; points above the threshold w never entered the map.</p>\n" +
+         render_svg(chart);
+}
+
+}  // namespace
+
+std::optional<Section> map_section(const RunData& run) {
+  std::vector<Eigen::Vector3f> points;
+  for (const Eigen::Vector3f& p : run.map)
+    if (p.allFinite()) points.push_back(p);
+  if (points.size() < 10) return std::nullopt;
+  std::vector<float> heights;
+  for (const Eigen::Vector3f& p : points) heights.push_back(p.z());
+  const double z_lo = percentile(heights, 0.02), z_hi = std::max(percentile(heights, 0.98), z_lo + 1e-3);
+  const Chart chart = top_view_chart("Map, top view (highest point per cell)",
+                                     top_view(points, heights, [&](float z) { return (z - z_lo) / (z_hi - z_lo); }), run);
+  std::string html = "<p>map.ply, " + std::to_string(points.size()) + " points in the frame of trajectory.tum (drawn in red); cells of " +
+                     fixed(chart.raster.cell, 2) + " m coloured by height from " + fixed(z_lo, 2) +
+                     " m (<span style=\"color:" + height_colour(0.0) + "\">dark blue</span>) to " + fixed(z_hi, 2) +
+                     " m (<span style=\"color:#b8a000\">yellow</span>).</p>\n" + render_svg(chart);
+  if (!run.map_traces.empty() && run.map_traces.size() == run.map.size() && points.size() == run.map.size()) html += trace_view(run);
   return Section{"map", "Map", html};
 }
 

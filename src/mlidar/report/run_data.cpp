@@ -4,6 +4,7 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/file_bytes.hpp"
+#include "mlidar/io/point_covariance_fields.hpp"
 #include "mlidar/io/point_table.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/report/run_report.hpp"
@@ -46,6 +47,21 @@ std::optional<T> read_optional(const fs::path& path, Read read, std::vector<std:
   }
 }
 
+struct MapPoints {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<float> traces;  ///< one per point, or empty
+};
+
+/// map.ply's points and, when it has them, their covariances' traces (a map with covariances has only finite points).
+MapPoints read_map(const fs::path& path) {
+  const io::CloudFile cloud = io::read_cloud(path);
+  MapPoints map{io::to_scan(cloud.table, path.string()).points, {}};
+  if (const auto covariances = io::read_point_covariances(cloud.table, path.string());
+      covariances && covariances->size() == map.points.size())
+    for (const io::UpperCovariance& c : *covariances) map.traces.push_back(c[0] + c[3] + c[5]);
+  return map;
+}
+
 /// The last name of `path`, also for "run/" and "./run".
 std::string folder_name(const fs::path& path) {
   fs::path normal = path.lexically_normal();
@@ -79,9 +95,10 @@ RunData load_run(const fs::path& folder, const ReportSource& source) {
     run.pose_covariances = std::move(*covariances);
   run.extrinsics = read_optional<io::Extrinsics>(
       folder / "extrinsics.yaml", [](const fs::path& p) { return io::read_extrinsics(p); }, run.notes);
-  if (auto points = read_optional<std::vector<Eigen::Vector3f>>(
-          folder / "map.ply", [](const fs::path& p) { return io::to_scan(io::read_cloud(p).table, p.string()).points; }, run.notes))
-    run.map = std::move(*points);
+  if (auto map = read_optional<MapPoints>(folder / "map.ply", read_map, run.notes)) {
+    run.map = std::move(map->points);
+    run.map_traces = std::move(map->traces);
+  }
   run.dataset = !source.dataset.empty() ? source.dataset.string() : dataset_argument(run.run_info);
   if (run.dataset.empty()) return run;
   const fs::path truth = fs::path(run.dataset) / "groundtruth";

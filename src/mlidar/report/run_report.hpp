@@ -34,6 +34,7 @@ struct RunData {
   std::vector<io::StampedCovariance> pose_covariances;  ///< pose_covariance.txt (empty when absent)
   std::optional<io::Extrinsics> extrinsics;
   std::vector<Eigen::Vector3f> map;             ///< map.ply's points (empty when absent)
+  std::vector<float> map_traces;                ///< tr(Sigma) of each map point when map.ply carries covariances, else empty
   std::optional<Trajectory> gt_trajectory;      ///< DATASET/groundtruth/trajectory.tum
   std::optional<io::Extrinsics> gt_extrinsics;  ///< DATASET/groundtruth/extrinsics.yaml
   std::vector<std::string> notes;               ///< what could not be read, in words
