@@ -29,10 +29,7 @@ SurfaceError surface_error(const std::vector<Eigen::Vector3f>& points, const std
     distances.push_back(std::abs(d));
     out.signed_mean_m += d;
     if (!covariances) continue;
-    const io::UpperCovariance& c = (*covariances)[i];
-    Eigen::Matrix3d sigma;
-    sigma << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
-    const double variance = n.dot(sigma * n);
+    const double variance = n.dot(io::to_matrix((*covariances)[i]) * n);
     if (!(variance > 0.0)) continue;  // no spread along the normal: e is undefined
     const double e = d / std::sqrt(variance);
     ++normalized.count;

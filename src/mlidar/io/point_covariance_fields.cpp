@@ -22,8 +22,7 @@ std::string problem_of(const UpperCovariance& c) {
   for (const float v : c)
     if (!std::isfinite(v)) return "holds a non-finite value";
   if (c[0] < 0.0F || c[3] < 0.0F || c[5] < 0.0F) return "has a negative variance";
-  Eigen::Matrix3d m;
-  m << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
+  const Eigen::Matrix3d m = to_matrix(c);
   const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m, Eigen::EigenvaluesOnly).eigenvalues()(0);
   const double scale = std::max(1e-12, m.diagonal().maxCoeff());
   if (smallest < -1e-5 * scale) return "is not positive semi-definite (smallest eigenvalue " + std::to_string(smallest) + " m^2)";
@@ -31,6 +30,17 @@ std::string problem_of(const UpperCovariance& c) {
 }
 
 }  // namespace
+
+Eigen::Matrix3d to_matrix(const UpperCovariance& c) {
+  Eigen::Matrix3d m;
+  m << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
+  return m;
+}
+
+UpperCovariance to_upper(const Eigen::Matrix3d& m) {
+  return {static_cast<float>(m(0, 0)), static_cast<float>(m(0, 1)), static_cast<float>(m(0, 2)),
+          static_cast<float>(m(1, 1)), static_cast<float>(m(1, 2)), static_cast<float>(m(2, 2))};
+}
 
 void add_point_covariances(PointTable& table, const std::vector<UpperCovariance>& covariances) {
   if (covariances.size() != table.num_points) throw std::invalid_argument("add_point_covariances: one covariance per point");

@@ -7,12 +7,18 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "mlidar/io/point_table.hpp"
 
 namespace mlidar::io {
 
 /// xx, xy, xz, yy, yz, zz.
 using UpperCovariance = std::array<float, 6>;
+
+/// The symmetric 3x3 matrix an upper triangle stands for, and the upper triangle of a (symmetric) matrix.
+Eigen::Matrix3d to_matrix(const UpperCovariance& c);
+UpperCovariance to_upper(const Eigen::Matrix3d& m);
 
 inline constexpr const char* kCovarianceFieldNames[] = {"cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"};
 

@@ -41,13 +41,7 @@ MapCloud map_in_base(MapCloud map, const BaseFrame& frame) {
   for (Eigen::Vector3f& p : map.points) p = frame.point_to_base(p);
   if (map.covariances) {
     const Mat3 R = frame.T_base_reference.rotation_matrix();
-    for (io::UpperCovariance& c : *map.covariances) {
-      Mat3 m;
-      m << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
-      const Mat3 r = R * m * R.transpose();
-      c = {static_cast<float>(r(0, 0)), static_cast<float>(r(0, 1)), static_cast<float>(r(0, 2)),
-           static_cast<float>(r(1, 1)), static_cast<float>(r(1, 2)), static_cast<float>(r(2, 2))};
-    }
+    for (io::UpperCovariance& c : *map.covariances) c = io::to_upper(R * io::to_matrix(c) * R.transpose());
   }
   return map;
 }
