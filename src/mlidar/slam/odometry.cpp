@@ -172,18 +172,6 @@ std::size_t drop_uncertain(double trace_threshold_m2, std::vector<CovariantPoint
   return before - points.size();
 }
 
-void add_covariant(const std::vector<CovariantPoint>& points, VoxelMap& map) {
-  std::vector<Eigen::Vector3f> xyz;
-  std::vector<PointCovariance> covariances;
-  xyz.reserve(points.size());
-  covariances.reserve(points.size());
-  for (const CovariantPoint& p : points) {
-    xyz.push_back(p.point);
-    covariances.push_back(p.covariance);
-  }
-  map.add(xyz, covariances);
-}
-
 }  // namespace
 
 std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, const LidarFeatures& features,
@@ -224,8 +212,8 @@ std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, c
       planes = covariance_voxel_filter(planes, ua.voxel_filter_m, ua.trace_threshold_m2);
     }
     report->points_added = edges.size() + planes.size();
-    add_covariant(edges, edge_map_);
-    add_covariant(planes, plane_map_);
+    edge_map_.add(edges);
+    plane_map_.add(planes);
   }
   const Eigen::Vector3f origin = T_world_centroid.translation().cast<float>();
   edge_map_.remove_far(origin, config_.local_map_radius_m);
@@ -399,6 +387,11 @@ std::size_t drop_uncertain_features(double trace_threshold_m2, LidarFeatures& f,
   return before - f.edges.size() - f.planes.size();
 }
 
+/// The range 1-sigma for a LiDAR's points: its model's, else the configured one.
+double range_sigma(const LidarSetup& lidar, const UncertaintyConfig& ua) {
+  return lidar.model.range_noise_sigma > 0.0 ? lidar.model.range_noise_sigma : ua.range_sigma_m;
+}
+
 }  // namespace
 
 void Odometry::collect_features(FrameResult& result) {
@@ -411,10 +404,9 @@ void Odometry::collect_features(FrameResult& result) {
     // those with tr(Sigma) > w are left out of the registration and the map (sec 4.8.2).
     result.lidar_uncertain.assign(lidars_.size(), 0);
     tbb::parallel_for(std::size_t{0}, lidars_.size(), [&](std::size_t i) {
-      const double range_sigma_m = lidars_[i].model.range_noise_sigma > 0.0 ? lidars_[i].model.range_noise_sigma : ua.range_sigma_m;
       const UncertainPose T_base_lidar{lidars_[i].T_base_lidar, lidars_[i].extrinsic_covariance};
-      edge_covariances[i] = feature_covariances(features_[i].edges, T_base_lidar, range_sigma_m, ua.angular_sigma_rad);
-      plane_covariances[i] = feature_covariances(features_[i].planes, T_base_lidar, range_sigma_m, ua.angular_sigma_rad);
+      edge_covariances[i] = feature_covariances(features_[i].edges, T_base_lidar, range_sigma(lidars_[i], ua), ua.angular_sigma_rad);
+      plane_covariances[i] = feature_covariances(features_[i].planes, T_base_lidar, range_sigma(lidars_[i], ua), ua.angular_sigma_rad);
       result.lidar_uncertain[i] = drop_uncertain_features(ua.trace_threshold_m2, features_[i], edge_covariances[i], plane_covariances[i]);
     });
   }
@@ -423,9 +415,8 @@ void Odometry::collect_features(FrameResult& result) {
     result.lidar_rows.push_back(features_[i].rows);
     result.lidar_row_source.push_back(features_[i].row_source);
     append_features(features_[i], frame_features_);
-    const double range_sigma_m = lidars_[i].model.range_noise_sigma > 0.0 ? lidars_[i].model.range_noise_sigma : ua.range_sigma_m;
     frame_blocks_.push_back({features_[i].edges.size(), features_[i].planes.size(),
-                             UncertainPose{lidars_[i].T_base_lidar, lidars_[i].extrinsic_covariance}, range_sigma_m});
+                             UncertainPose{lidars_[i].T_base_lidar, lidars_[i].extrinsic_covariance}, range_sigma(lidars_[i], ua)});
   }
   result.edge_features = frame_features_.edges.size();
   result.plane_features = frame_features_.planes.size();
@@ -501,10 +492,8 @@ FrameResult Odometry::process(const Frame& frame) {
   } else if (result.trust == Trust::kTrusted) {
     // The first frame defines the world: no pose doubt.
     const bool registered = centroid_poses_.size() > 1;
-    const Mat6 Xi_reg = config_.uncertainty.enabled && registered
-                            ? registration_covariance(result.registration.hessian, registration_residual_variance(result.registration),
-                                                      result.registration.weak_translation, MotionPriorSigma{})
-                            : Mat6::Zero();
+    const Mat6 Xi_reg =
+        config_.uncertainty.enabled && registered ? registration_covariance(result.registration, MotionPriorSigma{}) : Mat6::Zero();
     result.mapping = update_map(T_world_centroid, frame_features_, frame_blocks_, Xi_reg);
   }
   // Every registered frame, suspect ones too: a lasting change of the fit (a rougher scene) moves the

@@ -48,10 +48,6 @@ std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoi
     Mat3 covariance = Mat3::Zero();
   };
   const double inv = 1.0 / cube_m;
-  const auto key_of = [inv](const Eigen::Vector3f& p) {
-    return VoxelKey{static_cast<std::int32_t>(std::floor(p.x() * inv)), static_cast<std::int32_t>(std::floor(p.y() * inv)),
-                    static_cast<std::int32_t>(std::floor(p.z() * inv))};
-  };
   const auto raw_weight = [trace_threshold_m2](const CovariantPoint& p) {
     return std::max(0.0, trace_threshold_m2 - p.covariance.trace());
   };
@@ -59,7 +55,7 @@ std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoi
   std::vector<Cube> cubes;
   std::vector<std::size_t> cube_of(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const auto [it, added] = index.try_emplace(key_of(points[i].point), cubes.size());
+    const auto [it, added] = index.try_emplace(voxel_key(points[i].point, inv), cubes.size());
     if (added) cubes.emplace_back();
     cube_of[i] = it->second;
     cubes[it->second].weight_sum += raw_weight(points[i]);

@@ -37,6 +37,10 @@ Mat6 registration_covariance(const Mat6& hessian, double residual_variance, cons
   return 0.5 * (covariance + covariance.transpose());
 }
 
+Mat6 registration_covariance(const RegistrationResult& registration, const MotionPriorSigma& prior) {
+  return registration_covariance(registration.hessian, registration_residual_variance(registration), registration.weak_translation, prior);
+}
+
 const Mat6& PoseCovarianceChain::add(const FrameResult& frame, bool first) {
   if (first) {
     covariance_.setZero();
@@ -51,8 +55,7 @@ const Mat6& PoseCovarianceChain::add(const FrameResult& frame, bool first) {
   }
   lost_frames_ = 0;
   const RegistrationResult& registration = frame.registration;
-  covariance_ +=
-      registration_covariance(registration.hessian, registration_residual_variance(registration), registration.weak_translation, prior_);
+  covariance_ += registration_covariance(registration, prior_);
   if (frame.suspect()) covariance_ += prediction;
   const Vec3& held = registration.weak_translation;
   if (registration.degenerate && held.squaredNorm() > 0.0) {

@@ -55,6 +55,8 @@ double registration_residual_variance(const RegistrationResult& registration);
 /// Xi_reg = (P H P / sigma^2 + Lambda_prior)^-1; Lambda_prior^-1 alone when sigma^2 is 0 (nothing matched).
 /// `held_translation`: the unit translation (world) the registration kept at the prior, zero for none.
 Mat6 registration_covariance(const Mat6& hessian, double residual_variance, const Vec3& held_translation, const MotionPriorSigma& prior);
+/// The same of one registration: its H, its residual variance and the translation it held.
+Mat6 registration_covariance(const RegistrationResult& registration, const MotionPriorSigma& prior);
 
 /// The accumulated covariance, one frame at a time (frames in order).
 class PoseCovarianceChain {

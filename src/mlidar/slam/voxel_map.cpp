@@ -10,35 +10,31 @@ VoxelMap::VoxelMap(double voxel_size, int max_points_per_voxel) : voxel_size_(vo
     throw std::invalid_argument("VoxelMap: voxel_size must be > 0 and max_points_per_voxel >= 1");
 }
 
-VoxelKey VoxelMap::key_of(const Eigen::Vector3f& p) const {
-  const double inv = 1.0 / voxel_size_;
-  return {static_cast<std::int32_t>(std::floor(p.x() * inv)), static_cast<std::int32_t>(std::floor(p.y() * inv)),
-          static_cast<std::int32_t>(std::floor(p.z() * inv))};
+void VoxelMap::insert(const Eigen::Vector3f& p, const PointCovariance* covariance) {
+  if (!p.allFinite()) return;
+  const VoxelKey key = key_of(p);
+  auto& bucket = map_[key];
+  if (bucket.empty()) bucket.reserve(static_cast<std::size_t>(max_points_));
+  if (static_cast<int>(bucket.size()) >= max_points_) return;
+  if (covariance != nullptr) {
+    auto& kept = covariances_[key];
+    kept.resize(bucket.size());  // points added without a covariance before this one: zero
+    kept.push_back(*covariance);
+  }
+  bucket.push_back(p);
 }
 
 void VoxelMap::add(std::span<const Eigen::Vector3f> points) {
-  for (const auto& p : points) {
-    if (!p.allFinite()) continue;
-    auto& bucket = map_[key_of(p)];
-    if (bucket.empty()) bucket.reserve(static_cast<std::size_t>(max_points_));
-    if (static_cast<int>(bucket.size()) < max_points_) bucket.push_back(p);
-  }
+  for (const auto& p : points) insert(p, nullptr);
 }
 
 void VoxelMap::add(std::span<const Eigen::Vector3f> points, std::span<const PointCovariance> covariances) {
   if (points.size() != covariances.size()) throw std::invalid_argument("VoxelMap::add: one covariance per point");
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3f& p = points[i];
-    if (!p.allFinite()) continue;
-    const VoxelKey key = key_of(p);
-    auto& bucket = map_[key];
-    if (static_cast<int>(bucket.size()) >= max_points_) continue;
-    if (bucket.empty()) bucket.reserve(static_cast<std::size_t>(max_points_));
-    auto& kept = covariances_[key];
-    kept.resize(bucket.size());  // points added without a covariance before this one: zero
-    bucket.push_back(p);
-    kept.push_back(covariances[i]);
-  }
+  for (std::size_t i = 0; i < points.size(); ++i) insert(points[i], &covariances[i]);
+}
+
+void VoxelMap::add(std::span<const CovariantPoint> points) {
+  for (const CovariantPoint& p : points) insert(p.point, &p.covariance);
 }
 
 void VoxelMap::remove_far(const Eigen::Vector3f& origin, double max_distance) {

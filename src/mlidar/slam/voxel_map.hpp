@@ -9,6 +9,8 @@
 #include <span>
 #include <vector>
 
+#include <cmath>
+
 #include <tsl/robin_map.h>
 #include <Eigen/Core>
 
@@ -20,6 +22,12 @@ struct VoxelKey {
   std::int32_t x = 0, y = 0, z = 0;
   bool operator==(const VoxelKey&) const = default;
 };
+
+/// The cube of edge 1 / inv_edge that holds p (floor of each coordinate times inv_edge).
+inline VoxelKey voxel_key(const Eigen::Vector3f& p, double inv_edge) {
+  return {static_cast<std::int32_t>(std::floor(p.x() * inv_edge)), static_cast<std::int32_t>(std::floor(p.y() * inv_edge)),
+          static_cast<std::int32_t>(std::floor(p.z() * inv_edge))};
+}
 
 struct VoxelKeyHash {
   std::size_t operator()(const VoxelKey& key) const {
@@ -41,6 +49,7 @@ class VoxelMap {
   void add(std::span<const Eigen::Vector3f> points);
   /// The same with each point's covariance (same length; uncertainty-aware mapping), kept for covariances().
   void add(std::span<const Eigen::Vector3f> points, std::span<const PointCovariance> covariances);
+  void add(std::span<const CovariantPoint> points);
   /// Drops voxels whose first point lies farther than max_distance from origin.
   void remove_far(const Eigen::Vector3f& origin, double max_distance);
 
@@ -57,7 +66,9 @@ class VoxelMap {
   double voxel_size() const { return voxel_size_; }
 
  private:
-  VoxelKey key_of(const Eigen::Vector3f& p) const;
+  VoxelKey key_of(const Eigen::Vector3f& p) const { return voxel_key(p, 1.0 / voxel_size_); }
+  /// Adds p unless it is not finite or its voxel is full; with `covariance`, keeps it beside the point.
+  void insert(const Eigen::Vector3f& p, const PointCovariance* covariance);
 
   double voxel_size_;
   int max_points_;
