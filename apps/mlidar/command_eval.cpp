@@ -126,7 +126,7 @@ int run_map(const MapOptions& options) {
       throw InputError(options.map, "x y z", "non-finite points in a map with covariances: every point needs a position");
     std::vector<double> traces;
     traces.reserve(covariances->size());
-    for (const io::UpperCovariance& c : *covariances) traces.push_back(static_cast<double>(c[0]) + c[3] + c[5]);
+    for (const io::UpperCovariance& c : *covariances) traces.push_back(io::covariance_trace(c));
     metrics.covariance_trace = eval::summarize_traces(std::move(traces));
   }
   std::cout << eval::format_table(metrics, metrics_options);

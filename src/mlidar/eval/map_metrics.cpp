@@ -116,10 +116,6 @@ MapMetrics compute_map_metrics(const std::vector<Eigen::Vector3f>& points, const
   return metrics;
 }
 
-}  // namespace mlidar::eval
-
-namespace mlidar::eval {
-
 CovarianceTraceStats summarize_traces(std::vector<double> traces) {
   CovarianceTraceStats stats;
   stats.count = traces.size();

@@ -1,7 +1,6 @@
 #include "mlidar/io/point_covariance_fields.hpp"
 
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
@@ -10,10 +9,6 @@
 
 namespace mlidar::io {
 namespace {
-
-void fill(FieldColumn& column, const std::vector<float>& values) {
-  std::memcpy(column.data.data(), values.data(), values.size() * sizeof(float));
-}
 
 std::string at_point(std::size_t i) { return " at point " + std::to_string(i); }
 
@@ -47,10 +42,11 @@ void add_point_covariances(PointTable& table, const std::vector<UpperCovariance>
   std::vector<float> values(covariances.size());
   for (std::size_t k = 0; k < 6; ++k) {
     for (std::size_t i = 0; i < covariances.size(); ++i) values[i] = covariances[i][k];
-    fill(table.add_field(kCovarianceFieldNames[k], ScalarType::kF32), values);
+    add_f32_field(table, kCovarianceFieldNames[k], values);
   }
-  for (std::size_t i = 0; i < covariances.size(); ++i) values[i] = covariances[i][0] + covariances[i][3] + covariances[i][5];
-  fill(table.add_field("cov_trace", ScalarType::kF32), values);
+  for (std::size_t i = 0; i < covariances.size(); ++i)
+    values[i] = covariances[i][0] + covariances[i][3] + covariances[i][5];  // in float, as read back
+  add_f32_field(table, "cov_trace", values);
 }
 
 std::optional<std::vector<UpperCovariance>> read_point_covariances(const PointTable& table, const std::string& source) {
@@ -68,7 +64,7 @@ std::optional<std::vector<UpperCovariance>> read_point_covariances(const PointTa
     const std::string problem = problem_of(out[i]);
     if (!problem.empty()) throw InputError(source, "cov_xx..cov_zz", "the covariance" + at_point(i) + " " + problem);
     if (trace != nullptr) {
-      const double sum = static_cast<double>(out[i][0]) + out[i][3] + out[i][5];
+      const double sum = covariance_trace(out[i]);
       const double given = trace->value(i);
       if (!(std::abs(given - sum) <= 1e-4 * std::max(1e-6, std::abs(sum))))
         throw InputError(source, "cov_trace",

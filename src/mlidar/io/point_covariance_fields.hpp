@@ -19,6 +19,8 @@ using UpperCovariance = std::array<float, 6>;
 /// The symmetric 3x3 matrix an upper triangle stands for, and the upper triangle of a (symmetric) matrix.
 Eigen::Matrix3d to_matrix(const UpperCovariance& c);
 UpperCovariance to_upper(const Eigen::Matrix3d& m);
+/// cov_xx + cov_yy + cov_zz, summed in double (the cov_trace field holds the float sum).
+inline double covariance_trace(const UpperCovariance& c) { return static_cast<double>(c[0]) + c[3] + c[5]; }
 
 inline constexpr const char* kCovarianceFieldNames[] = {"cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"};
 

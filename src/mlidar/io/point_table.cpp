@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 
 #include "mlidar/core/error.hpp"
@@ -209,6 +210,11 @@ Scan to_scan(const PointTable& table, const std::string& source, const ScanOptio
   return scan;
 }
 
+void add_f32_field(PointTable& table, const std::string& name, std::span<const float> values) {
+  if (values.size() != table.num_points) throw std::invalid_argument("add_f32_field: one value per point for " + name);
+  std::memcpy(table.add_field(name, ScalarType::kF32).data.data(), values.data(), values.size() * sizeof(float));
+}
+
 PointTable from_scan(const Scan& scan) {
   PointTable table;
   table.num_points = scan.size();
@@ -220,9 +226,7 @@ PointTable from_scan(const Scan& scan) {
     auto* out = reinterpret_cast<float*>(column.data.data());
     for (std::size_t i = 0; i < n; ++i) out[i] = scan.points[i][axis];
   }
-  if (scan.has_intensity()) {
-    std::memcpy(table.add_field("intensity", ScalarType::kF32).data.data(), scan.intensity.data(), n * sizeof(float));
-  }
+  if (scan.has_intensity()) add_f32_field(table, "intensity", scan.intensity);
   if (scan.has_ring()) {
     std::memcpy(table.add_field("ring", ScalarType::kU16).data.data(), scan.ring.data(), n * sizeof(std::uint16_t));
   }

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,9 @@ struct PointTable {
   /// Appends an empty column sized for num_points and returns it.
   FieldColumn& add_field(const std::string& name, ScalarType type, std::uint32_t count = 1);
 };
+
+/// Appends a float32 column `name` holding `values` (one per point of `table`; std::invalid_argument otherwise).
+void add_f32_field(PointTable& table, const std::string& name, std::span<const float> values);
 
 /// Units of a per-point time field.
 enum class TimeUnit : std::uint8_t { kAuto, kSeconds, kMilliseconds, kMicroseconds, kNanoseconds };

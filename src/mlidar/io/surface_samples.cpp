@@ -1,7 +1,6 @@
 #include "mlidar/io/surface_samples.hpp"
 
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -25,8 +24,7 @@ void write_surface_samples(const std::filesystem::path& path, const SurfaceSampl
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<float> values(samples.normals.size());
     for (std::size_t i = 0; i < values.size(); ++i) values[i] = samples.normals[i][axis];
-    FieldColumn& column = cloud.table.add_field(kNormalFields[axis], ScalarType::kF32);
-    std::memcpy(column.data.data(), values.data(), values.size() * sizeof(float));
+    add_f32_field(cloud.table, kNormalFields[axis], values);
   }
   write_cloud(path, cloud);
 }

@@ -22,18 +22,25 @@ Eigen::Vector3f BaseFrame::point_to_base(const Eigen::Vector3f& p_world_referenc
   return p.cast<float>();
 }
 
+namespace {
+
+/// A [t additive, r local] covariance with its translation block turned by R (the rotation's block is local).
+Mat6 translation_rotated(const Mat6& covariance, const Mat3& R) {
+  Mat6 J = Mat6::Identity();
+  J.topLeftCorner<3, 3>() = R;
+  return J * covariance * J.transpose();
+}
+
+}  // namespace
+
 Mat6 BaseFrame::covariance_to_base(const Mat6& covariance_reference) const {
   if (is_reference) return covariance_reference;
-  Mat6 J = Mat6::Identity();
-  J.topLeftCorner<3, 3>() = T_base_reference.rotation().toRotationMatrix();
-  return J * covariance_reference * J.transpose();
+  return translation_rotated(covariance_reference, T_base_reference.rotation().toRotationMatrix());
 }
 
 Mat6 BaseFrame::covariance_to_reference(const Mat6& covariance_base) const {
   if (is_reference) return covariance_base;
-  Mat6 J = Mat6::Identity();
-  J.topLeftCorner<3, 3>() = T_base_reference.rotation().toRotationMatrix().transpose();
-  return J * covariance_base * J.transpose();
+  return translation_rotated(covariance_base, T_base_reference.rotation().toRotationMatrix().transpose());
 }
 
 BaseFrame base_frame(const io::FrameSource& source) {

@@ -6,7 +6,6 @@
 
 #include <tbb/global_control.h>
 
-#include "mlidar/core/conversions.hpp"
 #include "mlidar/core/covariance.hpp"
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
@@ -67,8 +66,8 @@ std::optional<io::Extrinsics> given_extrinsics(const SlamJob& job, const io::Fra
 Mat6 given_extrinsic_covariance(const std::optional<Mat6>& covariance_base, const SE3& T_reference_lidar, bool is_reference,
                                 const BaseFrame& frame, const SlamConfig& config) {
   if (is_reference) return Mat6::Zero();
-  const Mat6 local = covariance_base ? frame.covariance_to_reference(*covariance_base) : extrinsic_prior_covariance(config);
-  return covariance_in_left_tangent(T_reference_lidar, config.window.extrinsic_covariance_scale * local);
+  const std::optional<Mat6> local = covariance_base ? std::optional(frame.covariance_to_reference(*covariance_base)) : std::nullopt;
+  return extrinsic_doubt(local, T_reference_lidar, config);
 }
 
 /// The estimator's LiDARs, their given extrinsics (the dataset's or --extrinsics FILE's) relative to the reference LiDAR.
