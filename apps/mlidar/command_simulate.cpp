@@ -1,4 +1,4 @@
-// `mlidar simulate drive|corner`: the built-in simulator with ground truth.
+// `mlidar simulate drive|corner|detection`: the built-in simulator with ground truth.
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -12,6 +12,7 @@
 #include "mlidar/io/run_folder.hpp"
 #include "mlidar/io/trajectory_io.hpp"
 #include "mlidar/sim/corner_dataset.hpp"
+#include "mlidar/sim/detection_dataset.hpp"
 #include "mlidar/sim/drive_dataset.hpp"
 
 namespace mlidar::cli {
@@ -26,6 +27,16 @@ struct DriveOptions {
   std::string perturb = "0,0";
   std::string encoding = "binary";
   double surfaces = 0.0;
+  bool overwrite = false;
+  std::string out;
+};
+
+struct DetectionOptions {
+  std::string rig = "lyft";
+  int frames = 100;
+  std::uint64_t seed = 1;
+  std::string split = "train";
+  std::string encoding = "binary";
   bool overwrite = false;
   std::string out;
 };
@@ -99,6 +110,36 @@ int run_corner(CornerOptions& options, const CliContext& context) {
   return 0;
 }
 
+int run_detection(const DetectionOptions& options, const CliContext& context) {
+  sim::DetectionSpec spec;
+  spec.rig = sim::load_rig(options.rig);
+  spec.frames = options.frames;
+  spec.seed = options.seed;
+  spec.split = sim::detection_split_from_name(options.split);
+  spec.encoding = io::pcd_encoding_from_name(options.encoding);
+  io::RunFolder run(options.out, "simulate detection", context.run_folder(options.overwrite, {}));
+  sim::write_detection_dataset(spec, run.path(), terminal_progress_bar());
+  run.commit();
+  std::cout << "wrote " << options.out << ": " << spec.frames << " labelled " << options.split << " scenes of " << spec.rig.lidars.size()
+            << " LiDAR(s), rig " << spec.rig.name << " (labels in groundtruth/label_2 and groundtruth/labels)\n";
+  return 0;
+}
+
+void add_detection(CLI::App& simulate, DetectionOptions& options) {
+  CLI::App* cmd = simulate.add_subcommand("detection", "Labelled street scenes for 3D detection: cars, pedestrians, cyclists");
+  cmd->add_option("--rig", options.rig, "lyft (TOP, FRONT_LEFT, FRONT_RIGHT), another named rig, or a rig .yaml")->capture_default_str();
+  cmd->add_option("--frames", options.frames, "Number of scenes (one frame each)")->check(CLI::Range(1, 1000000))->capture_default_str();
+  cmd->add_option("--seed", options.seed, "Random seed (same seed and split, same bytes)")->capture_default_str();
+  cmd->add_option("--split", options.split, "train or test: the two never share a scene")
+      ->check(CLI::IsMember({"train", "test"}))
+      ->capture_default_str();
+  cmd->add_option("--encoding", options.encoding, "PCD encoding of the scans")
+      ->check(CLI::IsMember({"binary", "binary_compressed"}))
+      ->capture_default_str();
+  cmd->add_option("--out", options.out, "Dataset folder (a new or empty folder, or an earlier simulate output)")->required();
+  add_overwrite_flag(*cmd, options.overwrite);
+}
+
 }  // namespace
 
 Command register_simulate(CLI::App& app, const CliContext& context) {
@@ -140,8 +181,13 @@ Command register_simulate(CLI::App& app, const CliContext& context) {
   corner_cmd->add_option("--configuration", corner->spec.configuration, "Ground truth: 1 or 2 (Table 2.2), 0 random")
       ->capture_default_str();
 
-  return {sub, [drive, corner, drive_cmd, &context] {
+  auto detection = std::make_shared<DetectionOptions>();
+  add_detection(*sub, *detection);
+  CLI::App* detection_cmd = sub->get_subcommand("detection");
+
+  return {sub, [drive, corner, detection, drive_cmd, detection_cmd, &context] {
             if (drive_cmd->parsed()) return run_drive(*drive, context);
+            if (detection_cmd->parsed()) return run_detection(*detection, context);
             return run_corner(*corner, context);
           }};
 }

@@ -13,6 +13,7 @@ std::vector<Command> register_commands(CLI::App& app, const CliContext& context)
           register_odometry(app, context),
           register_slam(app, context),
           register_bag(app, context),
+          register_perturb(app, context),
           register_eval(app),
           register_report(app),
           register_doctor(app)};
@@ -46,7 +47,8 @@ std::string suspect_frames_warning(const std::vector<std::size_t>& frames) {
   for (std::size_t i = 0; i < frames.size() && i < 10; ++i) text << (i > 0 ? ", " : "") << frames[i];
   if (frames.size() > 10) text << " and " << frames.size() - 10 << " more";
   text << ", from 0): the best registration fits clearly worse than the frames before, another alignment fits as well, or "
-          "it is degenerate and moved far from the motion prior; the pose may be wrong and the frame was kept out of the map (metrics.json per_frame trust)\n";
+          "it is degenerate and moved far from the motion prior; the pose may be wrong and the frame was kept out of the map (metrics.json "
+          "per_frame trust)\n";
   return text.str();
 }
 

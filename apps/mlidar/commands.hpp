@@ -39,6 +39,7 @@ Command register_slam(CLI::App& app, const CliContext& context);
 Command register_bag(CLI::App& app, const CliContext& context);
 Command register_report(CLI::App& app);
 Command register_doctor(CLI::App& app);
+Command register_perturb(CLI::App& app, const CliContext& context);
 
 /// All sub-commands, in the order `mlidar --help` lists them. `context` must outlive the returned commands.
 std::vector<Command> register_commands(CLI::App& app, const CliContext& context);

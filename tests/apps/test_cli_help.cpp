@@ -32,9 +32,10 @@ std::vector<std::string> option_names(const std::string& command_line) {
 }
 
 TEST(CliHelp, EverySubCommandEndsWithExamplesThatParse) {
-  const std::vector<std::string> commands = {"info",          "convert",         "simulate drive", "simulate corner", "calibrate planes",
-                                             "calibrate refine", "calibrate auto", "odometry",       "slam",            "bag info",
-                                             "bag export",    "eval traj",       "eval calib",     "eval map"};
+  const std::vector<std::string> commands = {
+      "info",           "convert",  "simulate drive", "simulate corner", "simulate detection", "calibrate planes", "calibrate refine",
+      "calibrate auto", "odometry", "slam",           "bag info",        "bag export",         "perturb",          "eval traj",
+      "eval calib",     "eval map"};
   const std::filesystem::path dir = scratch_dir();
   std::filesystem::create_directories(dir / "run");  // the folder `eval traj --plot run/...` writes into
   for (const std::string& command : commands) {

@@ -52,7 +52,9 @@ std::string staging_prefix(const fs::path& out) {
 }
 
 /// Commands whose output is a dataset: other commands' input, replaced only by a command that writes datasets.
-bool writes_dataset(const std::string& command) { return command.rfind("simulate", 0) == 0 || command == "bag export"; }
+bool writes_dataset(const std::string& command) {
+  return command.rfind("simulate", 0) == 0 || command == "bag export" || command == "perturb";
+}
 
 std::string utc_text(std::chrono::system_clock::time_point time) {
   const std::time_t t = std::chrono::system_clock::to_time_t(time);

@@ -11,7 +11,7 @@
 // What --out may be (checked when the RunFolder is made, before the job runs):
 //   - a new folder (its parent is created), or an empty folder;
 //   - an earlier mlidar run folder (it holds run.json with "tool": "mlidar").
-//     A dataset written by `mlidar simulate` or `bag export` is replaced only
+//     A dataset written by `mlidar simulate`, `bag export` or `perturb` is replaced only
 //     by one of those: it is other commands' input;
 //   - anything else (a folder holding other files, a dataset, a file) only
 //     with --overwrite (RunFolderOptions::overwrite), never a file;
