@@ -189,7 +189,7 @@ void add_map(CLI::App& eval_app, std::shared_ptr<MapOptions> options) {
 }  // namespace
 
 Command register_eval(CLI::App& app) {
-  CLI::App* sub = app.add_subcommand("eval", "Evaluate trajectories, extrinsics and maps (evo / KITTI definitions)");
+  CLI::App* sub = app.add_subcommand("eval", "Evaluate trajectories, extrinsics, maps and 3D detections (evo / KITTI definitions)");
   sub->require_subcommand(1);
   auto traj = std::make_shared<TrajOptions>();
   auto calib = std::make_shared<CalibOptions>();
@@ -197,7 +197,9 @@ Command register_eval(CLI::App& app) {
   add_traj(*sub, traj);
   add_calib(*sub, calib);
   add_map(*sub, map);
-  return {sub, [sub, traj, calib, map] {
+  const Command detections = add_eval_detections(*sub);
+  return {sub, [sub, traj, calib, map, detections] {
+            if (sub->got_subcommand(detections.sub)) return detections.run();
             if (sub->got_subcommand("traj")) return run_traj(*traj);
             if (sub->got_subcommand("calib")) return run_calib(*calib);
             return run_map(*map);

@@ -46,6 +46,9 @@ const std::vector<Examples>& examples() {
       {{"eval", "traj"}, {"mlidar eval traj --gt sim/groundtruth/trajectory.tum --est run/trajectory.tum --plot run/trajectory.svg"}},
       {{"eval", "calib"}, {"mlidar eval calib --gt sim/groundtruth/extrinsics.yaml --est calib/extrinsics.yaml --json calib.json"}},
       {{"eval", "map"}, {"mlidar eval map --map run/map.ply --radius 0.3"}},
+      {{"eval", "detections"},
+       {"mlidar eval detections --gt det_test --pred detector_out --json ap.json --plot pr.svg",
+        "mlidar eval detections --gt det_test/groundtruth --pred detector_out/label_2 --classes car --iou car=0.5"}},
       {{"doctor"}, {"mlidar doctor sim", "mlidar doctor drive.bag --topics /top/points:top,/front/points:front --json doctor.json"}},
       {{"report"}, {"mlidar report run", "mlidar report run --dataset sim --out run_with_truth.html"}},
   };

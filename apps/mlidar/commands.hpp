@@ -34,6 +34,8 @@ Command register_eval(CLI::App& app);
 Command register_calibrate(CLI::App& app, const CliContext& context);
 /// `calibrate refine` under the `calibrate` parent (command_calibrate_refine.cpp).
 Command add_calibrate_refine(CLI::App& calibrate);
+/// `eval detections` under the `eval` parent (command_eval_detections.cpp).
+Command add_eval_detections(CLI::App& eval);
 Command register_odometry(CLI::App& app, const CliContext& context);
 Command register_slam(CLI::App& app, const CliContext& context);
 Command register_bag(CLI::App& app, const CliContext& context);

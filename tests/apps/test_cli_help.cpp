@@ -35,7 +35,7 @@ TEST(CliHelp, EverySubCommandEndsWithExamplesThatParse) {
   const std::vector<std::string> commands = {
       "info",           "convert",  "simulate drive", "simulate corner", "simulate detection", "calibrate planes", "calibrate refine",
       "calibrate auto", "odometry", "slam",           "bag info",        "bag export",         "perturb",          "eval traj",
-      "eval calib",     "eval map"};
+      "eval calib",     "eval map", "eval detections"};
   const std::filesystem::path dir = scratch_dir();
   std::filesystem::create_directories(dir / "run");  // the folder `eval traj --plot run/...` writes into
   for (const std::string& command : commands) {

@@ -85,6 +85,14 @@ constexpr const char* kLabelColumns[] = {"type",       "truncated",   "occluded"
                                          "bbox right", "bbox bottom", "height",     "width", "length",    "location x",
                                          "location y", "location z",  "rotation_y", "score"};
 
+}  // namespace
+
+std::string kitti_label_field(std::size_t line, std::size_t column) {
+  return line_field(line) + " column " + std::to_string(column + 1) + " (" + kLabelColumns[column] + ")";
+}
+
+namespace {
+
 KittiObject parse_label_line(const std::vector<std::string_view>& tokens, std::size_t line, const std::string& source) {
   if (tokens.size() != 15 && tokens.size() != 16) {
     throw InputError(source, line_field(line),
@@ -92,16 +100,13 @@ KittiObject parse_label_line(const std::vector<std::string_view>& tokens, std::s
                      "or 16 with a score, found " +
                          std::to_string(tokens.size()));
   }
-  const auto number = [&](std::size_t column) {
-    return parse_finite(tokens[column], source,
-                        line_field(line) + " column " + std::to_string(column + 1) + " (" + kLabelColumns[column] + ")");
-  };
+  const auto number = [&](std::size_t column) { return parse_finite(tokens[column], source, kitti_label_field(line, column)); };
   KittiObject object;
   object.type = tokens[0];
   object.truncated = number(1);
-  const long long occluded = parse_integer(tokens[2], source, line_field(line) + " column 3 (occluded)");
+  const long long occluded = parse_integer(tokens[2], source, kitti_label_field(line, 2));
   if (occluded < -1 || occluded > 3) {
-    throw InputError(source, line_field(line) + " column 3 (occluded)", "expected -1, 0, 1, 2 or 3, found " + std::to_string(occluded));
+    throw InputError(source, kitti_label_field(line, 2), "expected -1, 0, 1, 2 or 3, found " + std::to_string(occluded));
   }
   object.occluded = static_cast<int>(occluded);
   object.alpha = number(3);
@@ -110,6 +115,7 @@ KittiObject parse_label_line(const std::vector<std::string_view>& tokens, std::s
   object.location = {number(11), number(12), number(13)};
   object.rotation_y = number(14);
   if (tokens.size() == 16) object.score = number(15);
+  object.line = static_cast<int>(line);
   return object;
 }
 
@@ -128,11 +134,11 @@ std::vector<KittiObject> read_kitti_labels(const std::filesystem::path& path) {
   return parse_kitti_labels(read_file_text(path), path.string());
 }
 
-void write_kitti_labels(const std::filesystem::path& path, const std::vector<KittiObject>& objects) {
+std::string format_kitti_labels(const std::vector<KittiObject>& objects, const std::string& destination) {
   std::string text;
   for (const auto& o : objects) {
     if (o.type.empty() || std::any_of(o.type.begin(), o.type.end(), [](char c) { return c == ' ' || c == '\t' || c == '\n'; })) {
-      throw OutputError(path.string() + ": object type '" + o.type + "' is empty or holds whitespace");
+      throw OutputError(destination + ": object type '" + o.type + "' is empty or holds whitespace");
     }
     std::string line = o.type;
     const auto append = [&line](const std::string& value) { line.append(1, ' ').append(value); };
@@ -146,6 +152,11 @@ void write_kitti_labels(const std::filesystem::path& path, const std::vector<Kit
     if (o.score) append(exact_number(*o.score));
     text.append(line).append(1, '\n');
   }
+  return text;
+}
+
+void write_kitti_labels(const std::filesystem::path& path, const std::vector<KittiObject>& objects) {
+  const std::string text = format_kitti_labels(objects, path.string());
   write_atomically(path, [&text](std::ostream& out) { out << text; });
 }
 

@@ -34,10 +34,17 @@ struct KittiObject {
   Eigen::Vector3d location{0, 0, 0};    ///< bottom centre in the camera frame
   double rotation_y = 0.0;
   std::optional<double> score;  ///< detections only
+  int line = 0;                 ///< 1-based line it was read from (0: not read from text)
 };
 
+/// "line N column C (NAME)": how label errors name a field (column 0-based: 0 type ... 8-10 height width length,
+/// 11-13 location, 14 rotation_y, 15 score).
+std::string kitti_label_field(std::size_t line, std::size_t column);
 std::vector<KittiObject> parse_kitti_labels(const std::string& text, const std::string& source);
 std::vector<KittiObject> read_kitti_labels(const std::filesystem::path& path);
+/// The label_2 lines of `objects` (exact numbers); OutputError naming `destination` for a type that is empty or
+/// holds whitespace.
+std::string format_kitti_labels(const std::vector<KittiObject>& objects, const std::string& destination);
 void write_kitti_labels(const std::filesystem::path& path, const std::vector<KittiObject>& objects);
 
 /// A KITTI calibration file: named matrices of 9 or 12 numbers.

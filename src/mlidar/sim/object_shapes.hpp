@@ -9,14 +9,16 @@
 #include <string>
 #include <vector>
 
+#include "mlidar/io/detection_labels.hpp"
 #include "mlidar/sim/primitives.hpp"
 #include "mlidar/sim/scene.hpp"
 
 namespace mlidar::sim {
 
-enum class ObjectClass : std::uint8_t { kCar, kPedestrian, kCyclist };
+/// The detection classes, as `eval detections` reads them.
+using io::ObjectClass;
 
-/// KITTI's class name: "Car", "Pedestrian", "Cyclist".
+/// KITTI's class name: "Car", "Pedestrian", "Cyclist" (label_2 files; io::object_class_name is lowercase).
 std::string kitti_class_name(ObjectClass object_class);
 
 /// An object of one class with its parts, placed on the ground.
