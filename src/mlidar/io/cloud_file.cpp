@@ -1,7 +1,5 @@
 #include "mlidar/io/cloud_file.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <cstring>
 #include <span>
 #include <string_view>
@@ -11,6 +9,7 @@
 #include "mlidar/io/kitti.hpp"
 #include "mlidar/io/pcd.hpp"
 #include "mlidar/io/ply.hpp"
+#include "mlidar/io/text_fields.hpp"
 
 namespace mlidar::io {
 
@@ -28,17 +27,12 @@ const char* cloud_format_name(CloudFormat format) {
 
 namespace {
 
-std::string lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
-  return text;
-}
-
 bool ends_with(const std::string& text, const std::string& suffix) {
   return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 int guess_bin_floats(const std::filesystem::path& path, std::size_t size) {
-  if (ends_with(lower(path.filename().string()), ".pcd.bin")) return 5;
+  if (ends_with(lowercase(path.filename().string()), ".pcd.bin")) return 5;
   if (size % 16 != 0 && size % 20 == 0) return 5;
   return 4;
 }
@@ -69,7 +63,7 @@ PointTable without_padding(const PointTable& table) {
 }  // namespace
 
 CloudFormat cloud_format_of(const std::filesystem::path& path) {
-  const std::string extension = lower(path.extension().string());
+  const std::string extension = lowercase(path.extension().string());
   if (extension == ".pcd") return CloudFormat::kPcd;
   if (extension == ".ply") return CloudFormat::kPly;
   if (extension == ".bin") return CloudFormat::kKittiBin;

@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "mlidar/core/error.hpp"
+#include "mlidar/io/text_fields.hpp"
 
 namespace mlidar::io {
 namespace {
@@ -50,8 +51,7 @@ std::vector<std::filesystem::path> natural_sorted_clouds(const std::filesystem::
   std::vector<std::filesystem::path> clouds;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (!entry.is_regular_file()) continue;
-    std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string ext = lowercase(entry.path().extension().string());
     if (ext == ".pcd" || ext == ".ply" || ext == ".bin") clouds.push_back(entry.path());
   }
   std::sort(clouds.begin(), clouds.end(),

@@ -2,7 +2,6 @@
 #include "mlidar/io/detection_labels.hpp"
 
 #include <algorithm>
-#include <cctype>
 
 #include <nlohmann/json.hpp>
 
@@ -66,12 +65,6 @@ KittiObject kitti_line(const LabelledBox& labelled) {
   return object;
 }
 
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
-
 /// objects[index].key as a non-negative integer.
 int points_total_of(const nlohmann::json& object, std::size_t index, const std::string& source) {
   const std::string field = "objects[" + std::to_string(index) + "].points_total";
@@ -108,7 +101,7 @@ std::string object_class_name(ObjectClass object_class) {
 }
 
 std::optional<ObjectClass> object_class_from_name(std::string_view name) {
-  const std::string wanted = lower(name);
+  const std::string wanted = lowercase(name);
   for (ObjectClass object_class : kObjectClasses) {
     if (object_class_name(object_class) == wanted) return object_class;
   }

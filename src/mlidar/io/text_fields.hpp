@@ -22,6 +22,8 @@ std::vector<NumberedLine> split_lines(std::string_view text);
 std::vector<std::string_view> split_tokens(std::string_view line, char separator = '\0');
 /// `line` without leading and trailing whitespace.
 std::string_view trim(std::string_view line);
+/// `text` with ASCII letters in lower case (file extensions, class names).
+std::string lowercase(std::string_view text);
 
 /// Parses the whole token as a double (InputError naming source and field otherwise).
 double parse_double(std::string_view token, const std::string& source, const std::string& field);

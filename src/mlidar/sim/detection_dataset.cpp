@@ -8,6 +8,7 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/dataset.hpp"
+#include "mlidar/io/detection_labels.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
 #include "mlidar/io/kitti.hpp"
 #include "mlidar/sim/acquisition.hpp"
@@ -25,12 +26,6 @@ std::string frame_name(int frame) {
   char name[16];
   std::snprintf(name, sizeof(name), "%06d", frame);
   return name;
-}
-
-std::string lower_class(const std::string& kitti_name) {
-  if (kitti_name == "Car") return "car";
-  if (kitti_name == "Pedestrian") return "pedestrian";
-  return "cyclist";
 }
 
 io::Dataset describe(const DetectionSpec& spec) {
@@ -60,7 +55,7 @@ nlohmann::json object_json(const LabelledObject& object, const io::KittiObject& 
   }
   const double distance = box.location.head<2>().norm();
   return {{"id", object.id},
-          {"class", lower_class(object.type)},
+          {"class", io::object_class_name(io::object_class_from_name(object.type).value())},
           {"box",
            {{"center_bottom", {box.location.x(), box.location.y(), box.location.z()}},
             {"size_lwh", {box.dimensions.z(), box.dimensions.y(), box.dimensions.x()}},
