@@ -95,7 +95,20 @@ TEST(CliSlam, OnlineCalibrationConvergesAndLidarOrderDoesNotMatter) {
   const Trajectory est = io::read_tum(run / "trajectory.tum");
   EXPECT_EQ(io::read_kitti_poses(run / "trajectory.kitti").poses.size(), static_cast<std::size_t>(kFrames));
   EXPECT_LT(ate_rmse(io::read_tum(sim / "groundtruth" / "trajectory.tum"), est), kMaxAteM);
-  EXPECT_GT(io::read_cloud(run / "map.ply").table.num_points, 1000U);
+  const io::CloudFile map = io::read_cloud(run / "map.ply");
+  EXPECT_GT(map.table.num_points, 1000U);
+  // Each map point's LiDAR (index into metrics.json's "lidars", here left, right): both contribute, none unknown. The
+  // right one little (measured 3 %): its points enter the map only once calibrated, into voxels the left one filled.
+  ASSERT_EQ(read_metrics(run)["lidars"], nlohmann::json::array({"left", "right"}));
+  const io::FieldColumn* lidar = map.table.find("lidar");
+  ASSERT_NE(lidar, nullptr);
+  std::array<std::size_t, 2> per_lidar{};
+  for (std::size_t i = 0; i < map.table.num_points; ++i) {
+    ASSERT_LT(lidar->value(i), 2.0) << i;
+    ++per_lidar[static_cast<std::size_t>(lidar->value(i))];
+  }
+  EXPECT_GT(per_lidar[0], map.table.num_points / 2);
+  EXPECT_GT(per_lidar[1], map.table.num_points / 100);
   // One pose covariance per written pose, from zero at the first frame; its rotation block (a local tangent:
   // its trace does not depend on the pose) grows frame by frame.
   const auto covariances = io::read_pose_covariances(run / "pose_covariance.txt");

@@ -103,6 +103,46 @@ TEST(PointUncertainty, VoxelFilterOfEqualCovariancesIsTheCentroid) {
   EXPECT_THROW(covariance_voxel_filter(points, 0.0, 0.1), std::invalid_argument);
 }
 
+TEST(PointUncertainty, VoxelFilterKeepsTheLidarOfEachCubesHeaviestPoint) {
+  const double w = 1.0;
+  const std::vector<CovariantPoint> points = {
+      {{0.2F, 0.2F, 0.2F}, PointCovariance::from(diagonal(0.2, 0.1, 0.1)), 0},  // cube (0,0,0), weight 0.6
+      {{0.6F, 0.4F, 0.2F}, PointCovariance::from(diagonal(0.1, 0.0, 0.0)), 2},  // cube (0,0,0), weight 0.9: the heaviest
+      {{1.5F, 0.1F, 0.1F}, PointCovariance::from(diagonal(0.1, 0.1, 0.1)), 1},  // cube (1,0,0), alone
+      {{1.6F, 0.1F, 0.1F}, PointCovariance::from(diagonal(0.1, 0.1, 0.1)), 0},  // same weight, later: the first is kept
+  };
+  const std::vector<CovariantPoint> out = covariance_voxel_filter(points, 1.0, w);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].source, 2);
+  EXPECT_EQ(out[1].source, 1);
+}
+
+TEST(PointUncertainty, MapKeepsEachPointsLidarBesideItThroughRemoval) {
+  VoxelMap map(1.0, 2);
+  // Points at x = 0.5 + i (one voxel each, two per voxel at most) seen by LiDAR i % 3; a third point of a voxel is refused.
+  std::vector<Eigen::Vector3f> points;
+  std::vector<std::uint8_t> sources;
+  for (int i = 0; i < 10; ++i)
+    for (int k = 0; k < 3; ++k) {
+      points.emplace_back(0.5F + static_cast<float>(i), 0.1F * static_cast<float>(k), 0.5F);
+      sources.push_back(static_cast<std::uint8_t>((i + k) % 3));
+    }
+  map.add(points, sources);
+  map.add(std::vector<Eigen::Vector3f>{{20.5F, 0.5F, 0.5F}});  // without a source
+  map.remove_far(Eigen::Vector3f(0.0F, 0.0F, 0.0F), 5.2);      // keeps x = 0.5 .. 4.5
+  const std::vector<Eigen::Vector3f> kept = map.points();
+  const std::vector<std::uint8_t> kept_sources = map.sources();
+  ASSERT_EQ(kept.size(), 10u);  // 5 voxels x 2 points
+  ASSERT_EQ(kept_sources.size(), kept.size());
+  for (std::size_t j = 0; j < kept.size(); ++j) {
+    const int i = static_cast<int>(std::floor(kept[j].x()));
+    const int k = static_cast<int>(std::lround(kept[j].y() / 0.1F));
+    EXPECT_LT(k, 2) << "the third point of a voxel was refused";
+    EXPECT_EQ(kept_sources[j], (i + k) % 3) << j;
+  }
+  EXPECT_THROW(map.add(points, std::vector<std::uint8_t>(2, 0)), std::invalid_argument);
+}
+
 TEST(PointUncertainty, MapKeepsEachPointsCovarianceBesideIt) {
   VoxelMap map(1.0, 4);
   const std::vector<Eigen::Vector3f> plain = {{0.1F, 0.1F, 0.1F}, {5.2F, 0.1F, 0.1F}};

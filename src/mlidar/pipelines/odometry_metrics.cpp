@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/core/covariance.hpp"
@@ -222,9 +223,12 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
 }
 
 MapCloud map_cloud(const slam::Odometry& odometry) {
-  MapCloud map{odometry.plane_map().points(), std::nullopt};
+  MapCloud map{odometry.plane_map().points(), std::nullopt, odometry.plane_map().sources(), {}};
   const auto edges = odometry.edge_map().points();
   map.points.insert(map.points.end(), edges.begin(), edges.end());
+  const auto edge_sources = odometry.edge_map().sources();
+  map.lidars.insert(map.lidars.end(), edge_sources.begin(), edge_sources.end());
+  for (const slam::LidarSetup& lidar : odometry.lidars()) map.lidar_names.push_back(lidar.name);
   if (odometry.config().uncertainty.enabled) {
     map.covariances.emplace();
     for (const slam::VoxelMap* part : {&odometry.plane_map(), &odometry.edge_map()})
@@ -242,6 +246,10 @@ void write_map_ply(const std::filesystem::path& path, const MapCloud& map) {
   cloud.format = io::CloudFormat::kPly;
   cloud.table = io::from_scan(scan);
   if (map.covariances) io::add_point_covariances(cloud.table, *map.covariances);
+  if (map.lidars.size() == map.points.size() && !map.lidar_names.empty()) {
+    io::FieldColumn& column = cloud.table.add_field("lidar", io::ScalarType::kU8);
+    std::memcpy(column.data.data(), map.lidars.data(), map.lidars.size());
+  }
   io::write_cloud(path, cloud);
 }
 

@@ -67,12 +67,15 @@ nlohmann::json timing_summary(std::vector<double> values);
 struct MapCloud {
   std::vector<Eigen::Vector3f> points;
   std::optional<std::vector<io::UpperCovariance>> covariances;  ///< one per point (m^2)
+  std::vector<std::uint8_t> lidars;                             ///< per point the index of the LiDAR that saw it (255: unknown)
+  std::vector<std::string> lidar_names;                         ///< index -> name (metrics.json "lidars" order)
 };
 MapCloud map_cloud(const slam::Odometry& odometry);
 
 /// The odometry's local maps (planes then edges) as a binary PLY, atomically.
 void write_map_ply(const std::filesystem::path& path, const slam::Odometry& odometry);
-/// A map as a binary PLY with the cov_ fields when it has covariances (io/point_covariance_fields.hpp), atomically.
+/// A map as a binary PLY with the cov_ fields when it has covariances (io/point_covariance_fields.hpp) and a uchar
+/// `lidar` field (index into metrics.json's "lidars"; 255 unknown) when it knows its points' LiDARs, atomically.
 void write_map_ply(const std::filesystem::path& path, const MapCloud& map);
 /// Points as a binary PLY, atomically.
 void write_map_ply(const std::filesystem::path& path, std::vector<Eigen::Vector3f> points);

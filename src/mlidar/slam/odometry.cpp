@@ -154,15 +154,18 @@ namespace {
 
 /// World points and covariances of one block's features (eq 4.29 through the LiDAR's compounded world pose).
 void append_covariant(const UncertainPose& T_world_lidar, const SE3& T_lidar_base, const SE3& T_world_base,
-                      std::span<const Eigen::Vector3f> points_base, double range_sigma_m, double angular_sigma_rad,
+                      std::span<const Eigen::Vector3f> points_base, double range_sigma_m, double angular_sigma_rad, std::uint8_t source,
                       std::vector<CovariantPoint>& out) {
   for (const Eigen::Vector3f& p : points_base) {
     const Vec3 p_base = p.cast<double>();
     const Vec3 p_lidar = T_lidar_base * p_base;
     const Mat3 Z = lidar_point_noise(p_lidar, range_sigma_m, angular_sigma_rad);
-    out.push_back({(T_world_base * p_base).cast<float>(), PointCovariance::from(point_covariance(T_world_lidar, p_lidar, Z))});
+    out.push_back({(T_world_base * p_base).cast<float>(), PointCovariance::from(point_covariance(T_world_lidar, p_lidar, Z)), source});
   }
 }
+
+/// The map's record of LiDAR `index` (VoxelMap::sources), saturated at kNoSource.
+std::uint8_t lidar_source(std::size_t index) { return static_cast<std::uint8_t>(std::min<std::size_t>(index, VoxelMap::kNoSource)); }
 
 /// Drops the points with tr(Sigma) > w (sec 4.8.2) and returns how many it dropped; adds every offered trace to `traces`.
 std::size_t drop_uncertain(double trace_threshold_m2, std::vector<CovariantPoint>& points, std::vector<double>& traces) {
@@ -179,23 +182,32 @@ std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, c
   std::optional<MappingReport> report;
   const UncertaintyConfig& ua = config_.uncertainty;
   if (!ua.enabled) {
+    std::vector<std::uint8_t> edge_sources, plane_sources;  // blocks are the LiDARs in order
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      edge_sources.insert(edge_sources.end(), blocks[b].edges, lidar_source(b));
+      plane_sources.insert(plane_sources.end(), blocks[b].planes, lidar_source(b));
+    }
+    if (edge_sources.size() != features.edges.size() || plane_sources.size() != features.planes.size())
+      throw std::logic_error("Odometry::update_map: feature blocks do not cover the features");
     std::vector<Eigen::Vector3f> world;
     append_transformed(T_world_centroid, features.edges, world);
-    edge_map_.add(world);
+    edge_map_.add(world, edge_sources);
     world.clear();
     append_transformed(T_world_centroid, features.planes, world);
-    plane_map_.add(world);
+    plane_map_.add(world, plane_sources);
   } else {
     // Sec 4.8.1-4.8.2: each LiDAR's world pose compounded (fourth order), each point's Sigma, tr(Sigma) <= w, eq 4.30.
     std::vector<CovariantPoint> edges, planes;
     std::size_t edge_at = 0, plane_at = 0;
-    for (const FeatureBlock& block : blocks) {
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      const FeatureBlock& block = blocks[b];
+      const std::uint8_t source = lidar_source(b);
       const UncertainPose T_world_lidar = compound({T_world_centroid, Xi_reg}, block.T_base_lidar);
       const SE3 T_lidar_base = block.T_base_lidar.T.inverse();
       append_covariant(T_world_lidar, T_lidar_base, T_world_centroid, std::span(features.edges).subspan(edge_at, block.edges),
-                       block.range_sigma_m, ua.angular_sigma_rad, edges);
+                       block.range_sigma_m, ua.angular_sigma_rad, source, edges);
       append_covariant(T_world_lidar, T_lidar_base, T_world_centroid, std::span(features.planes).subspan(plane_at, block.planes),
-                       block.range_sigma_m, ua.angular_sigma_rad, planes);
+                       block.range_sigma_m, ua.angular_sigma_rad, source, planes);
       edge_at += block.edges;
       plane_at += block.planes;
     }

@@ -46,6 +46,8 @@ std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoi
     double weight_sum = 0.0;  ///< sum of (w - tr Sigma_i) over its points
     Vec3 mean = Vec3::Zero();
     Mat3 covariance = Mat3::Zero();
+    double heaviest_weight = -1.0;
+    std::uint8_t source = 255;  ///< of the heaviest point
   };
   const double inv = 1.0 / cube_m;
   const auto raw_weight = [trace_threshold_m2](const CovariantPoint& p) {
@@ -58,7 +60,13 @@ std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoi
     const auto [it, added] = index.try_emplace(voxel_key(points[i].point, inv), cubes.size());
     if (added) cubes.emplace_back();
     cube_of[i] = it->second;
-    cubes[it->second].weight_sum += raw_weight(points[i]);
+    Cube& cube = cubes[it->second];
+    const double weight = raw_weight(points[i]);
+    cube.weight_sum += weight;
+    if (weight > cube.heaviest_weight) {
+      cube.heaviest_weight = weight;
+      cube.source = points[i].source;
+    }
   }
   for (std::size_t i = 0; i < points.size(); ++i) {
     Cube& cube = cubes[cube_of[i]];
@@ -70,7 +78,7 @@ std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoi
   std::vector<CovariantPoint> out;
   out.reserve(cubes.size());
   for (const Cube& cube : cubes)
-    if (cube.weight_sum > 0.0) out.push_back({cube.mean.cast<float>(), PointCovariance::from(cube.covariance)});
+    if (cube.weight_sum > 0.0) out.push_back({cube.mean.cast<float>(), PointCovariance::from(cube.covariance), cube.source});
   return out;
 }
 

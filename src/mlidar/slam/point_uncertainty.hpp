@@ -16,6 +16,7 @@
 // T_base_lidar with alpha Xi) (fourth order, Barfoot & Furgale 2014); those
 // with tr(Sigma) > w are dropped and the rest downsampled by eq 4.30.
 #include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -62,12 +63,13 @@ inline double uncertainty_weight(const PointCovariance& sigma, const Vec3& n_bas
 struct CovariantPoint {
   Eigen::Vector3f point = Eigen::Vector3f::Zero();
   PointCovariance covariance;
+  std::uint8_t source = 255;  ///< the LiDAR that saw it (its index), 255 when unknown
 };
 
 /// Eq 4.30: the points grouped by cubes of edge `cube_m` (> 0); each cube becomes one point
 /// y = sum w_i y_i, Sigma = sum w_i^2 Sigma_i with w_i = (w - tr Sigma_i) / sum_j (w - tr Sigma_j).
 /// Points with tr(Sigma) >= w carry no weight; a cube of only those is dropped. Output in the order each
-/// cube's first point came.
+/// cube's first point came; its source is that of the cube's heaviest point (the first of equals).
 std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2);
 
 }  // namespace mlidar::slam

@@ -10,7 +10,7 @@ VoxelMap::VoxelMap(double voxel_size, int max_points_per_voxel) : voxel_size_(vo
     throw std::invalid_argument("VoxelMap: voxel_size must be > 0 and max_points_per_voxel >= 1");
 }
 
-void VoxelMap::insert(const Eigen::Vector3f& p, const PointCovariance* covariance) {
+void VoxelMap::insert(const Eigen::Vector3f& p, const PointCovariance* covariance, std::uint8_t source) {
   if (!p.allFinite()) return;
   const VoxelKey key = key_of(p);
   auto& bucket = map_[key];
@@ -20,6 +20,11 @@ void VoxelMap::insert(const Eigen::Vector3f& p, const PointCovariance* covarianc
     auto& kept = covariances_[key];
     kept.resize(bucket.size());  // points added without a covariance before this one: zero
     kept.push_back(*covariance);
+  }
+  if (source != kNoSource) {
+    auto& kept = sources_[key];
+    kept.resize(bucket.size(), kNoSource);
+    kept.push_back(source);
   }
   bucket.push_back(p);
 }
@@ -34,7 +39,12 @@ void VoxelMap::add(std::span<const Eigen::Vector3f> points, std::span<const Poin
 }
 
 void VoxelMap::add(std::span<const CovariantPoint> points) {
-  for (const CovariantPoint& p : points) insert(p.point, &p.covariance);
+  for (const CovariantPoint& p : points) insert(p.point, &p.covariance, p.source);
+}
+
+void VoxelMap::add(std::span<const Eigen::Vector3f> points, std::span<const std::uint8_t> sources) {
+  if (points.size() != sources.size()) throw std::invalid_argument("VoxelMap::add: one source per point");
+  for (std::size_t i = 0; i < points.size(); ++i) insert(points[i], nullptr, sources[i]);
 }
 
 void VoxelMap::remove_far(const Eigen::Vector3f& origin, double max_distance) {
@@ -42,6 +52,7 @@ void VoxelMap::remove_far(const Eigen::Vector3f& origin, double max_distance) {
   for (auto it = map_.begin(); it != map_.end();) {
     if ((it->second.front() - origin).squaredNorm() > limit_sq) {
       covariances_.erase(it->first);
+      sources_.erase(it->first);
       it = map_.erase(it);
     } else {
       ++it;
@@ -133,6 +144,17 @@ std::vector<PointCovariance> VoxelMap::covariances() const {
     const std::size_t begin = all.size();
     if (it != covariances_.end()) all.insert(all.end(), it->second.begin(), it->second.end());
     all.resize(begin + bucket.size());
+  }
+  return all;
+}
+
+std::vector<std::uint8_t> VoxelMap::sources() const {
+  std::vector<std::uint8_t> all;
+  for (const auto& [key, bucket] : map_) {
+    const auto it = sources_.find(key);
+    const std::size_t begin = all.size();
+    if (it != sources_.end()) all.insert(all.end(), it->second.begin(), it->second.end());
+    all.resize(begin + bucket.size(), kNoSource);
   }
   return all;
 }

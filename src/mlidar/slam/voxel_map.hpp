@@ -49,7 +49,10 @@ class VoxelMap {
   void add(std::span<const Eigen::Vector3f> points);
   /// The same with each point's covariance (same length; uncertainty-aware mapping), kept for covariances().
   void add(std::span<const Eigen::Vector3f> points, std::span<const PointCovariance> covariances);
+  /// Covariant points, with their sources (CovariantPoint::source) kept for sources().
   void add(std::span<const CovariantPoint> points);
+  /// Points, each with the index of the LiDAR that saw it (same length), kept for sources().
+  void add(std::span<const Eigen::Vector3f> points, std::span<const std::uint8_t> sources);
   /// Drops voxels whose first point lies farther than max_distance from origin.
   void remove_far(const Eigen::Vector3f& origin, double max_distance);
 
@@ -61,14 +64,17 @@ class VoxelMap {
   std::vector<Eigen::Vector3f> points() const;
   /// Each point of points() (same order): its covariance, zero for a point added without one.
   std::vector<PointCovariance> covariances() const;
+  /// Each point of points() (same order): the LiDAR index it was added with, kNoSource when added without one.
+  std::vector<std::uint8_t> sources() const;
+  static constexpr std::uint8_t kNoSource = 255;
   std::size_t voxels() const { return map_.size(); }
   bool empty() const { return map_.empty(); }
   double voxel_size() const { return voxel_size_; }
 
  private:
   VoxelKey key_of(const Eigen::Vector3f& p) const { return voxel_key(p, 1.0 / voxel_size_); }
-  /// Adds p unless it is not finite or its voxel is full; with `covariance`, keeps it beside the point.
-  void insert(const Eigen::Vector3f& p, const PointCovariance* covariance);
+  /// Adds p unless it is not finite or its voxel is full; with `covariance` and a `source`, keeps them beside the point.
+  void insert(const Eigen::Vector3f& p, const PointCovariance* covariance, std::uint8_t source = kNoSource);
 
   double voxel_size_;
   int max_points_;
@@ -76,6 +82,8 @@ class VoxelMap {
   /// Per voxel, the covariances of its first points (a prefix of the bucket's; the rest are zero); only voxels
   /// that received a point with one.
   tsl::robin_map<VoxelKey, std::vector<PointCovariance>, VoxelKeyHash> covariances_;
+  /// Per voxel, the LiDAR indices of its first points, likewise (kNoSource for a point added without one).
+  tsl::robin_map<VoxelKey, std::vector<std::uint8_t>, VoxelKeyHash> sources_;
 };
 
 }  // namespace mlidar::slam
