@@ -23,6 +23,7 @@
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/pipelines/autocalib_config.hpp"
 #include "mlidar/pipelines/autocalib_job.hpp"
+#include "mlidar/report/pair_report.hpp"
 #include "mlidar/report/run_report.hpp"
 
 namespace mlidar::cli {
@@ -37,6 +38,7 @@ struct PlanesOptions {
   std::string config;
   std::string out;
   std::string report;
+  std::string html;  ///< the page with the clouds overlaid before and after
   bool strict = false;
 };
 
@@ -97,9 +99,43 @@ nlohmann::json report_json(const calib::PlanesResult& result, double seconds) {
           {"target", cloud_json(result.target)}};
 }
 
+void write_planes_html(const PlanesOptions& options, const std::string& ref_name, const std::string& target_name, const Scan& ref,
+                       const Scan& target, const std::optional<SE3>& guess, const calib::PlanesResult& result, double seconds) {
+  report::PairCalibration pair;
+  pair.command = "calibrate planes";
+  pair.ref_name = ref_name;
+  pair.target_name = target_name;
+  pair.ref_file = options.ref;
+  pair.target_file = options.target;
+  pair.ref_points = ref.points;
+  pair.target_points = target.points;
+  pair.T_ref_target_before = guess.value_or(SE3());
+  pair.before_words = guess ? "the --init guess" : "identity (no --init: the clouds as recorded)";
+  pair.T_ref_target = result.T_ref_target;
+  pair.covariance = result.covariance;
+  pair.verdict_level = result.ok() ? "ok" : "warn";
+  pair.verdict = result.ok() ? "ok: three planes found in both clouds, " + options.out + " written"
+                             : "written with warnings (" + options.out + "): check the overlay before using it";
+  for (const auto w : result.warnings) pair.reasons.emplace_back(calib::warning_name(w));
+  char text[160];
+  std::snprintf(text, sizeof text, "%.4f m, %d iterations%s", result.residual_sigma, result.iterations,
+                result.converged ? "" : " (not converged)");
+  pair.facts.emplace_back("residual sigma", text);
+  for (const auto* cloud : {&result.ref, &result.target}) {
+    std::snprintf(text, sizeof text, "%zu planes found; corner angles %.1f, %.1f, %.1f deg", cloud->planes_found, cloud->angles_deg[0],
+                  cloud->angles_deg[1], cloud->angles_deg[2]);
+    pair.facts.emplace_back(cloud == &result.ref ? ref_name : target_name, text);
+  }
+  std::snprintf(text, sizeof text, "%.2f s", seconds);
+  pair.facts.emplace_back("time", text);
+  const std::string html = report::render_pair_calibration_html(pair);
+  io::write_atomically(options.html, [&](std::ostream& out) { out << html; });
+}
+
 int run_planes(const PlanesOptions& options) {
   io::check_output_file(options.out, "--out");
   if (!options.report.empty()) io::check_output_file(options.report, "--report");
+  if (!options.html.empty()) io::check_output_file(options.html, "--html");
   const std::string ref_name = lidar_name(options.ref, "ref");
   std::string target_name = lidar_name(options.target, "target");
   if (target_name == ref_name) target_name = "target";
@@ -123,6 +159,7 @@ int run_planes(const PlanesOptions& options) {
     const std::string text = report_json(result, seconds).dump(2);
     io::write_atomically(options.report, [&](std::ostream& out) { out << text << '\n'; });
   }
+  if (!options.html.empty()) write_planes_html(options, ref_name, target_name, ref, target, guess, result, seconds);
   const Vec3& t = result.T_ref_target.translation();
   std::cout << "T_ref_target t = [" << t.x() << ", " << t.y() << ", " << t.z() << "] m, residual sigma " << result.residual_sigma << " m, "
             << result.iterations << " iterations, " << seconds << " s\n";
@@ -240,6 +277,9 @@ Command register_calibrate(CLI::App& app, const CliContext& context) {
   planes_cmd->add_option("--config", planes->config, "planes.yaml with PlanesConfig keys");
   planes_cmd->add_option("--out", planes->out, "Output extrinsics YAML (T_ref_target with covariance)")->required();
   planes_cmd->add_option("--report", planes->report, "JSON report: planes, angles, residuals, verdict");
+  planes_cmd->add_option(
+      "--html", planes->html,
+      "Page to look at: the verdict, the extrinsic with its 1-sigma and both clouds overlaid before and after (self-contained HTML)");
   planes_cmd->add_flag("--strict", planes->strict, "Exit 1 when the verdict carries a warning");
   auto autocal = std::make_shared<AutoOptions>();
   CLI::App* auto_cmd =

@@ -19,6 +19,7 @@
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
 #include "mlidar/io/opencalib.hpp"
+#include "mlidar/report/pair_report.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -31,6 +32,7 @@ struct RefineOptions {
   std::string init;
   std::string out;
   std::string report;
+  std::string html;         ///< the page with the clouds overlaid before and after
   std::string ref_name;     ///< empty: the --init YAML's base, else "ref"
   std::string target_name;  ///< empty: the --init YAML's one LiDAR besides the reference, else "target"
   int target_id = 1;
@@ -63,9 +65,9 @@ std::string target_in(const io::Extrinsics& extrinsics, const RefineOptions& opt
   if (others.size() == 1) return others.front();
   if (extrinsics.find("target") != nullptr) return "target";
   throw InputError(options.init, "lidars",
-                   others.empty() ? "no LiDAR besides the reference '" + ref_name + "'; the file must hold the target's guess"
-                                  : "several LiDARs besides the reference '" + ref_name + "' (" + names +
-                                        "); name the target with --target-name");
+                   others.empty()
+                       ? "no LiDAR besides the reference '" + ref_name + "'; the file must hold the target's guess"
+                       : "several LiDARs besides the reference '" + ref_name + "' (" + names + "); name the target with --target-name");
 }
 
 /// T_ref_target from the guess file: an extrinsics YAML naming the target (and
@@ -86,8 +88,7 @@ InitialGuess read_initial_guess(const RefineOptions& options) {
   const std::string target_name = target_in(extrinsics, options, ref_name);
   if (ref_name == target_name) throw UsageError("--ref-name and --target-name must differ");
   const io::LidarExtrinsic* target = extrinsics.find(target_name);
-  if (target == nullptr)
-    throw InputError(options.init, "lidars." + target_name, "missing; name the target LiDAR with --target-name");
+  if (target == nullptr) throw InputError(options.init, "lidars." + target_name, "missing; name the target LiDAR with --target-name");
   const io::LidarExtrinsic* ref = extrinsics.find(ref_name);
   if (ref == nullptr && extrinsics.base != ref_name)
     throw InputError(options.init, "lidars." + ref_name, "missing; the file must name the reference LiDAR (--ref-name) or use it as base");
@@ -163,11 +164,43 @@ void print_table(const calib::PairRefineResult& r, double seconds) {
   for (const std::string& reason : r.reasons) std::printf("  reason: %s\n", reason.c_str());
 }
 
+void write_html(const RefineOptions& options, const InitialGuess& guess, const Scan& ref, const Scan& target,
+                const calib::PairRefineResult& r, double seconds) {
+  report::PairCalibration pair;
+  pair.command = "calibrate refine";
+  pair.ref_name = guess.ref_name;
+  pair.target_name = guess.target_name;
+  pair.ref_file = options.ref;
+  pair.target_file = options.target;
+  pair.ref_points = ref.points;
+  pair.target_points = target.points;
+  pair.T_ref_target_before = r.T_init;
+  pair.before_words = "the --init guess";
+  pair.T_ref_target = r.T_ref_target;
+  const bool converged = r.verdict != calib::PairVerdict::kNotConverged;
+  if (converged) pair.covariance = r.covariance;
+  pair.verdict_level = converged ? "ok" : "bad";
+  pair.verdict = converged ? std::string(calib::to_string(r.verdict)) + ": " + options.out + " written"
+                           : "not converged: " + options.out + " was not written; the overlay shows where it stopped";
+  pair.reasons = r.reasons;
+  char text[160];
+  std::snprintf(text, sizeof text, "%.4f m over %.0f %% inliers", r.rmse, 100.0 * r.inlier_ratio);
+  pair.facts.emplace_back("residual RMSE", text);
+  std::snprintf(text, sizeof text, "%.2f of the target's points near the reference (omega %.3f)", r.overlap.fraction_b, r.overlap.omega());
+  pair.facts.emplace_back("overlap", text);
+  pair.facts.emplace_back("multi-start search",
+                          r.searched ? "yes, " + std::to_string(r.starts.size()) + " starts, answer from '" + r.chosen_start + "'" : "no");
+  std::snprintf(text, sizeof text, "%.2f s", seconds);
+  pair.facts.emplace_back("time", text);
+  const std::string html = report::render_pair_calibration_html(pair);
+  io::write_atomically(options.html, [&](std::ostream& out) { out << html; });
+}
+
 int run_refine(const RefineOptions& options) {
-  if (!options.ref_name.empty() && options.ref_name == options.target_name)
-    throw UsageError("--ref-name and --target-name must differ");
+  if (!options.ref_name.empty() && options.ref_name == options.target_name) throw UsageError("--ref-name and --target-name must differ");
   io::check_output_file(options.out, "--out");
   if (!options.report.empty()) io::check_output_file(options.report, "--report");
+  if (!options.html.empty()) io::check_output_file(options.html, "--html");
   const InitialGuess guess = read_initial_guess(options);
   const SE3& T_init = guess.T_ref_target;
   const Scan ref = io::to_scan(io::read_cloud(options.ref).table, options.ref);
@@ -190,6 +223,7 @@ int run_refine(const RefineOptions& options) {
     const std::string text = report_json(result, config.overlap_radius, seconds).dump(2);
     io::write_atomically(options.report, [&](std::ostream& out) { out << text << '\n'; });
   }
+  if (!options.html.empty()) write_html(options, guess, ref, target, result, seconds);
   print_table(result, seconds);
   if (!trusted) {
     std::cerr << "error: the refinement did not converge; " << options.out << " was not written"
@@ -218,6 +252,9 @@ Command add_calibrate_refine(CLI::App& calibrate) {
                   "written only when the refinement converged")
       ->required();
   cmd->add_option("--report", options->report, "JSON report: verdict, reasons, starts tried, overlap, covariance");
+  cmd->add_option(
+      "--html", options->html,
+      "Page to look at: the verdict, the extrinsic with its 1-sigma and both clouds overlaid before and after (self-contained HTML)");
   cmd->add_option("--ref-name", options->ref_name,
                   "Reference LiDAR name in --init YAML and --out (default: the YAML's base; 'ref' with initial_extrinsic.txt)");
   cmd->add_option("--target-name", options->target_name,

@@ -17,6 +17,7 @@
 #include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/surface_samples.hpp"
 #include "mlidar/io/trajectory_io.hpp"
+#include "mlidar/report/run_report.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -32,6 +33,8 @@ struct TrajOptions {
   std::string json_out;
   std::string plot_out;
   std::string covariance;  ///< RUN/pose_covariance.txt: report the poses' NEES
+  std::string out;         ///< a run folder: eval.json, the associated poses, report.html
+  bool overwrite = false;
 };
 
 struct CalibOptions {
@@ -69,7 +72,29 @@ bool is_kitti_format(const TrajOptions& options) {
 
 Trajectory read_trajectory(const std::string& path, bool kitti) { return kitti ? io::read_kitti_poses(path) : io::read_tum(path); }
 
-int run_traj(const TrajOptions& options) {
+/// Poses stamped with the ground truth's stamps of their association (a KITTI file's poses get its index stamps).
+Trajectory stamped(const std::vector<SE3>& poses, const std::vector<double>& stamps) {
+  Trajectory out;
+  for (std::size_t i = 0; i < poses.size(); ++i) out.poses.push_back({stamps[i], poses[i]});
+  return out;
+}
+
+/// `--out RUN`: eval.json, the associated pairs as groundtruth.tum / trajectory.tum (the estimate before alignment,
+/// at the ground truth's stamps, so the report re-associates them exactly) and report.html, committed together.
+void write_eval_run(const TrajOptions& options, const CliContext& context, const eval::TrajectoryReport& report,
+                    const nlohmann::json& json) {
+  std::vector<std::filesystem::path> inputs{options.gt, options.est};
+  if (!options.covariance.empty()) inputs.emplace_back(options.covariance);
+  io::RunFolder run(options.out, "eval traj", context.run_folder(options.overwrite, inputs));
+  write_json((run / "eval.json").string(), json);
+  io::write_tum(run / "groundtruth.tum", stamped(report.gt, report.stamps));
+  io::write_tum(run / "trajectory.tum", stamped(report.est, report.stamps));
+  report::write_run_report(run.path(), {"eval traj", {}, options.out});
+  run.commit();
+  std::cout << "wrote " << options.out << " (eval.json, report.html)\n";
+}
+
+int run_traj(const TrajOptions& options, const CliContext& context) {
   if (!options.json_out.empty()) io::check_output_file(options.json_out, "--json");
   if (!options.plot_out.empty()) io::check_output_file(options.plot_out, "--plot");
   const bool kitti = is_kitti_format(options);
@@ -97,6 +122,7 @@ int run_traj(const TrajOptions& options) {
     const std::string svg = eval::trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
     io::write_atomically(options.plot_out, [&](std::ostream& out) { out << svg; });
   }
+  if (!options.out.empty()) write_eval_run(options, context, report, json);
   return 0;
 }
 
@@ -161,6 +187,10 @@ void add_traj(CLI::App& eval_app, std::shared_ptr<TrajOptions> options) {
   sub->add_option("--plot", options->plot_out, "Write an SVG plot (top view and ATE over time) to this file");
   sub->add_option("--covariance", options->covariance,
                   "The run's pose_covariance.txt: also report the poses' NEES against the ground truth (aligned at the first pose)");
+  sub->add_option("--out", options->out,
+                  "Run folder: eval.json, groundtruth.tum and trajectory.tum (the associated poses), report.html with the error over "
+                  "time and the KITTI drift per segment length, run.json (a new or empty folder, or an earlier run)");
+  add_overwrite_flag(*sub, options->overwrite);
 }
 
 void add_calib(CLI::App& eval_app, std::shared_ptr<CalibOptions> options) {
@@ -188,7 +218,7 @@ void add_map(CLI::App& eval_app, std::shared_ptr<MapOptions> options) {
 
 }  // namespace
 
-Command register_eval(CLI::App& app) {
+Command register_eval(CLI::App& app, const CliContext& context) {
   CLI::App* sub = app.add_subcommand("eval", "Evaluate trajectories, extrinsics, maps and 3D detections (evo / KITTI definitions)");
   sub->require_subcommand(1);
   auto traj = std::make_shared<TrajOptions>();
@@ -198,9 +228,9 @@ Command register_eval(CLI::App& app) {
   add_calib(*sub, calib);
   add_map(*sub, map);
   const Command detections = add_eval_detections(*sub);
-  return {sub, [sub, traj, calib, map, detections] {
+  return {sub, [sub, traj, calib, map, detections, &context] {
             if (sub->got_subcommand(detections.sub)) return detections.run();
-            if (sub->got_subcommand("traj")) return run_traj(*traj);
+            if (sub->got_subcommand("traj")) return run_traj(*traj, context);
             if (sub->got_subcommand("calib")) return run_calib(*calib);
             return run_map(*map);
           }};

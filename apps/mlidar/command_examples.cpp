@@ -25,9 +25,10 @@ const std::vector<Examples>& examples() {
        {"mlidar simulate detection --rig lyft --frames 500 --seed 1 --split train --out det_train",
         "mlidar simulate detection --rig lyft --frames 300 --seed 2 --split test --out det_test"}},
       {{"calibrate", "planes"},
-       {"mlidar calibrate planes --ref corner/ref.pcd --target corner/target.pcd --out extrinsics.yaml --report planes.json"}},
+       {"mlidar calibrate planes --ref corner/ref.pcd --target corner/target.pcd --out extrinsics.yaml --report planes.json --html "
+        "planes.html"}},
       {{"calibrate", "refine"},
-       {"mlidar calibrate refine --ref top.pcd --target front.pcd --init guess.yaml --out front.yaml",
+       {"mlidar calibrate refine --ref top.pcd --target front.pcd --init guess.yaml --out front.yaml --html front.html",
         "mlidar calibrate refine --ref top.pcd --target right.pcd --init initial_extrinsic.txt --target-id 2 --out right.yaml "
         "--report right.json"}},
       {{"calibrate", "auto"},
@@ -43,7 +44,9 @@ const std::vector<Examples>& examples() {
         "mlidar perturb --dataset sim --alpha 0.1 --seed 1 --fused --out sim_perturbed"}},
       {{"bag", "info"}, {"mlidar bag info drive.bag", "mlidar bag info recording_0.mcap --json"}},
       {{"bag", "export"}, {"mlidar bag export drive.bag --topics /top/points:top,/front/points:front --out dataset"}},
-      {{"eval", "traj"}, {"mlidar eval traj --gt sim/groundtruth/trajectory.tum --est run/trajectory.tum --plot run/trajectory.svg"}},
+      {{"eval", "traj"},
+       {"mlidar eval traj --gt sim/groundtruth/trajectory.tum --est run/trajectory.tum --plot run/trajectory.svg",
+        "mlidar eval traj --gt sim/groundtruth/trajectory.tum --est run/trajectory.tum --out eval"}},
       {{"eval", "calib"}, {"mlidar eval calib --gt sim/groundtruth/extrinsics.yaml --est calib/extrinsics.yaml --json calib.json"}},
       {{"eval", "map"}, {"mlidar eval map --map run/map.ply --radius 0.3"}},
       {{"eval", "detections"},

@@ -30,7 +30,7 @@ struct CliContext {
 Command register_info(CLI::App& app);
 Command register_convert(CLI::App& app);
 Command register_simulate(CLI::App& app, const CliContext& context);
-Command register_eval(CLI::App& app);
+Command register_eval(CLI::App& app, const CliContext& context);
 Command register_calibrate(CLI::App& app, const CliContext& context);
 /// `calibrate refine` under the `calibrate` parent (command_calibrate_refine.cpp).
 Command add_calibrate_refine(CLI::App& calibrate);

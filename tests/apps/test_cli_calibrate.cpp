@@ -39,6 +39,14 @@ TEST(CliCalibrate, PlanesOnASimulatedCornerAndItsFailureModes) {
   const auto json = nlohmann::json::parse(std::ifstream(report));
   EXPECT_EQ(json["verdict"], "ok");
   EXPECT_EQ(json["ref"]["planes"].size(), 3U);
+  // --html: the clouds as recorded (no --init: identity) and after, and the warnings in words (the strict run below).
+  result = run_cli("calibrate planes --ref " + ref + " --target " + target + " --out " + quoted((dir / "html.yaml").string()) + " --html " +
+                   quoted((dir / "planes.html").string()));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::string page = read_text(dir / "planes.html");
+  EXPECT_NE(page.find("identity (no --init"), std::string::npos);
+  EXPECT_NE(page.find("<title>After, side view</title>"), std::string::npos);
+  EXPECT_NE(page.find("<li class=\"ok\">ok: three planes found"), std::string::npos);
 
   std::ofstream(dir / "flat.xyz.pcd") << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 400\nHEIGHT 1\n"
                                          "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 400\nDATA ascii\n";
@@ -61,6 +69,10 @@ TEST(CliCalibrate, PlanesOnASimulatedCornerAndItsFailureModes) {
                    quoted((dir / "strict.yaml").string()) + " --out " + quoted(out.string()));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.output.find("few_inliers"), std::string::npos) << result.output;
+  result = run_cli("calibrate planes --ref " + ref + " --target " + target + " --config " + quoted((dir / "strict.yaml").string()) +
+                   " --out " + quoted(out.string()) + " --html " + quoted((dir / "strict.html").string()));
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_NE(read_text(dir / "strict.html").find("<li class=\"warn\">few_inliers</li>"), std::string::npos);
   EXPECT_EQ(run_cli("calibrate planes --ref " + ref).exit_code, 2);
 }
 

@@ -46,6 +46,24 @@ TEST(CliCalibrateRefine, RealPairWritesExtrinsicsThatReadBack) {
   EXPECT_NE(json["verdict"], "not_converged");
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(json["T_ref_target"]["translation"][i].get<double>(), right->T_base_lidar.translation()(i), 1e-9);
   EXPECT_EQ(json["covariance"].size(), 36U);
+
+  // --html: the page with both clouds overlaid before and after (its geometry: tests/report/test_pair_report.cpp).
+  const fs::path html = dir / "pair.html";
+  ASSERT_EQ(run_cli(pair_arguments() + " --init " + quoted((scene() / "initial_extrinsic.txt").string()) + " --out " +
+                    quoted((dir / "again.yaml").string()) + " --html " + quoted(html.string()))
+                .exit_code,
+            0);
+  const std::string page = read_text(html);
+  for (const char* title : {"Before, top view", "After, top view", "Before, side view", "After, side view"})
+    EXPECT_NE(page.find("<title>" + std::string(title) + "</title>"), std::string::npos) << title;
+  EXPECT_NE(page.find("<li class=\"ok\">"), std::string::npos);
+  EXPECT_EQ(page.find("http"), std::string::npos);
+  // An existing folder as --html is a usage error before any work.
+  EXPECT_EQ(run_cli(pair_arguments() + " --init " + quoted((scene() / "initial_extrinsic.txt").string()) + " --out " +
+                    quoted((dir / "third.yaml").string()) + " --html " + quoted(dir.string()))
+                .exit_code,
+            2);
+  EXPECT_FALSE(fs::exists(dir / "third.yaml"));
 }
 
 TEST(CliCalibrateRefine, BadInitIsBadInputNamingFileAndField) {
@@ -74,19 +92,20 @@ TEST(CliCalibrateRefine, BadInitIsBadInputNamingFileAndField) {
 TEST(CliCalibrateRefine, NamesComeFromTheGuessFileWhenNotGiven) {
   MLIDAR_REQUIRE_SHARED_DATA();
   const fs::path dir = scratch_dir();
-  const std::string clouds = "calibrate refine --ref " + quoted((scene() / "top.pcd").string()) + " --target " +
-                             quoted((scene() / "right.pcd").string());
+  const std::string clouds =
+      "calibrate refine --ref " + quoted((scene() / "top.pcd").string()) + " --target " + quoted((scene() / "right.pcd").string());
   // The guess of scene 0001's initial_extrinsic.txt for device 2, as an extrinsics YAML (rounded).
   const fs::path reference = dir / "reference.yaml";
-  ASSERT_EQ(run_cli(pair_arguments() + " --init " + quoted((scene() / "initial_extrinsic.txt").string()) + " --out " +
-                    quoted(reference.string()))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      run_cli(pair_arguments() + " --init " + quoted((scene() / "initial_extrinsic.txt").string()) + " --out " + quoted(reference.string()))
+          .exit_code,
+      0);
   const io::Extrinsics refined = io::read_extrinsics(reference);
   const SE3 T_top_right = refined.find("right")->T_base_lidar;
   io::Extrinsics guess;
   guess.base = "roof";
-  guess.lidars = {{"roof", SE3(), std::nullopt}, {"bumper_right", SE3(T_top_right.rotation(), T_top_right.translation() + Vec3(0.03, -0.02, 0.0)), std::nullopt}};
+  guess.lidars = {{"roof", SE3(), std::nullopt},
+                  {"bumper_right", SE3(T_top_right.rotation(), T_top_right.translation() + Vec3(0.03, -0.02, 0.0)), std::nullopt}};
   const fs::path init = dir / "guess.yaml";
   io::write_extrinsics(init, guess);
   const fs::path out = dir / "out.yaml";

@@ -1,4 +1,5 @@
-// report.html of a slam run and of a calibrate auto run, opened in headless
+// report.html of a slam run, a calibrate auto run and an eval traj run, and the
+// page of calibrate planes --html, opened in headless
 // Chromium (Debian's `chromium`, installed by scripts/install_deps.sh; the
 // test skips with a message when it is absent): no console message, no request
 // of the page's own beyond the file itself (Chromium's requests to its own
@@ -41,12 +42,12 @@ Rendered render(const fs::path& page, int width, int height, const fs::path& wor
   static int count = 0;
   const std::string name = "render" + std::to_string(++count);
   const fs::path png = work / (name + ".png"), net = work / (name + ".json");
-  const CliResult result = run_shell(quoted(chromium()) +
-                                     " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking"
-                                     " --disable-component-update --disable-sync --disable-dev-shm-usage --enable-logging=stderr --v=0 --user-data-dir=" +
-                                     quoted((work / (name + "-profile")).string()) + " --log-net-log=" + quoted(net.string()) +
-                                     " --window-size=" + std::to_string(width) + "," + std::to_string(height) +
-                                     " --screenshot=" + quoted(png.string()) + " " + quoted("file://" + fs::absolute(page).string()));
+  const CliResult result = run_shell(
+      quoted(chromium()) +
+      " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking"
+      " --disable-component-update --disable-sync --disable-dev-shm-usage --enable-logging=stderr --v=0 --user-data-dir=" +
+      quoted((work / (name + "-profile")).string()) + " --log-net-log=" + quoted(net.string()) + " --window-size=" + std::to_string(width) +
+      "," + std::to_string(height) + " --screenshot=" + quoted(png.string()) + " " + quoted("file://" + fs::absolute(page).string()));
   return {result.output, read_text(net), decode_png(read_text(png))};
 }
 
@@ -132,6 +133,40 @@ TEST(ReportBrowser, SlamAndCalibrateAutoReportsRenderOfflineWithEveryFigureDrawn
   }
   // slam: top and side views, the error over time, the map, lambda_min and the two estimate charts of `right`, timing.
   expect_every_figure_drawn(read_text(dir / "slam" / "report.html"), dir, 8);
+}
+
+TEST(ReportBrowser, EvalAndPairCalibrationPagesRenderOfflineWithEveryFigureDrawn) {
+  if (chromium().empty()) GTEST_SKIP() << "chromium not found (apt-get install chromium, or set MLIDAR_CHROMIUM)";
+  const fs::path dir = scratch_dir();
+  // eval traj: a 300 m arc and an estimate drifting in yaw and scale.
+  {
+    std::ofstream gt(dir / "gt.tum"), est(dir / "est.tum");
+    for (int i = 0; i <= 300; ++i) {
+      const double a = 0.004 * i, b = 0.0041 * i;
+      gt << 0.1 * i << ' ' << 250 * std::sin(a) << ' ' << 250 * (1 - std::cos(a)) << " 0 0 0 " << std::sin(a / 2) << ' ' << std::cos(a / 2)
+         << '\n';
+      est << 0.1 * i << ' ' << 251 * std::sin(b) << ' ' << 251 * (1 - std::cos(b)) << " 0 0 0 " << std::sin(b / 2) << ' ' << std::cos(b / 2)
+          << '\n';
+    }
+  }
+  const CliResult eval = run_cli("eval traj --gt " + quoted((dir / "gt.tum").string()) + " --est " + quoted((dir / "est.tum").string()) +
+                                 " --out " + quoted((dir / "eval").string()));
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  // calibrate planes --html on a simulated corner.
+  ASSERT_EQ(run_cli("simulate corner --angles 90:90 --seed 3 --out " + quoted((dir / "corner").string())).exit_code, 0);
+  const CliResult planes = run_cli("calibrate planes --ref " + quoted((dir / "corner" / "scans" / "l1" / "000000.pcd").string()) +
+                                   " --target " + quoted((dir / "corner" / "scans" / "l2" / "000000.pcd").string()) + " --out " +
+                                   quoted((dir / "planes.yaml").string()) + " --html " + quoted((dir / "planes.html").string()));
+  ASSERT_EQ(planes.exit_code, 0) << planes.output;
+
+  for (const fs::path& page : {dir / "eval" / "report.html", dir / "planes.html"}) {
+    const Rendered whole = render(page, 1360, 2400, dir);
+    expect_quiet(whole, page.string());
+    if (whole.image) EXPECT_GT(ink_of(*whole.image).grey_std, 5.0) << page;
+  }
+  // eval: the two KITTI drift charts, top and side views, the error over time; planes: before/after, top/side.
+  expect_every_figure_drawn(read_text(dir / "eval" / "report.html"), dir, 5);
+  expect_every_figure_drawn(read_text(dir / "planes.html"), dir, 4);
 }
 
 }  // namespace

@@ -165,16 +165,43 @@ TEST(KittiMetric, UniformScaleDriftOnAStraightLine) {
   }
   double expected_sum = 0.0;
   std::size_t expected_segments = 0;
+  const auto kitti = compute_kitti_odometry(gt, est);
+  ASSERT_TRUE(kitti.has_value());
+  ASSERT_EQ(kitti->by_length.size(), 8u);
   for (int length = 100; length <= 800; length += 100) {
     const int starts = (1000 - length - 1) / 10 + 1;
     expected_segments += static_cast<std::size_t>(starts);
     expected_sum += starts * eps * (length + 1.0) / length;
+    // Per length (the devkit's drift-against-length plot): every segment of length L drifts eps (L + 1) / L.
+    const KittiLengthDrift& drift = kitti->by_length[static_cast<std::size_t>(length / 100 - 1)];
+    EXPECT_EQ(drift.length_m, length);
+    EXPECT_EQ(drift.segments, static_cast<std::size_t>(starts));
+    EXPECT_NEAR(drift.translation_percent, 100.0 * eps * (length + 1.0) / length, 1e-9);
+    EXPECT_NEAR(drift.rotation_deg_per_100m, 0.0, 1e-9);
   }
-  const auto kitti = compute_kitti_odometry(gt, est);
-  ASSERT_TRUE(kitti.has_value());
   EXPECT_EQ(kitti->segments, expected_segments);
   EXPECT_NEAR(kitti->translation_percent, 100.0 * expected_sum / static_cast<double>(expected_segments), 1e-9);
   EXPECT_NEAR(kitti->rotation_deg_per_100m, 0.0, 1e-9);
+}
+
+TEST(KittiMetric, ConstantYawRateErrorGivesItsDriftPerLengthOnlyWhereSegmentsFit) {
+  // 351 poses 1 m apart on the x axis; the estimate turns 0.001 rad more about z per metre (its positions on the
+  // same line): a segment of length L ends at first + L + 1 and its rotation error is 0.001 (L + 1) rad, so
+  // r_err / L = 0.001 (L + 1) / L rad/m. Only 100-300 m segments fit in 350 m.
+  std::vector<SE3> gt, est;
+  for (int i = 0; i <= 350; ++i) {
+    gt.emplace_back(Quat::Identity(), Vec3(i, 0, 0));
+    est.emplace_back(Quat(Eigen::AngleAxisd(0.001 * i, Vec3::UnitZ())), Vec3(i, 0, 0));
+  }
+  const auto kitti = compute_kitti_odometry(gt, est);
+  ASSERT_TRUE(kitti.has_value());
+  ASSERT_EQ(kitti->by_length.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double length = 100.0 * static_cast<double>(k + 1);
+    EXPECT_EQ(kitti->by_length[k].length_m, length);
+    EXPECT_EQ(kitti->by_length[k].segments, static_cast<std::size_t>((350 - length - 1) / 10) + 1);
+    EXPECT_NEAR(kitti->by_length[k].rotation_deg_per_100m, 100.0 * 0.001 * (length + 1.0) / length * 180.0 / std::numbers::pi, 1e-6);
+  }
 }
 
 TEST(TrajectoryOptions, BadValuesAreUsageErrors) {

@@ -58,7 +58,13 @@ nlohmann::json to_json(const TrajectoryReport& report) {
   if (report.kitti.has_value()) {
     json["kitti"] = {{"segments", report.kitti->segments},
                      {"translation_percent", report.kitti->translation_percent},
-                     {"rotation_deg_per_100m", report.kitti->rotation_deg_per_100m}};
+                     {"rotation_deg_per_100m", report.kitti->rotation_deg_per_100m},
+                     {"by_length", nlohmann::json::array()}};
+    for (const KittiLengthDrift& drift : report.kitti->by_length)
+      json["kitti"]["by_length"].push_back({{"length_m", drift.length_m},
+                                            {"segments", drift.segments},
+                                            {"translation_percent", drift.translation_percent},
+                                            {"rotation_deg_per_100m", drift.rotation_deg_per_100m}});
   }
   return json;
 }

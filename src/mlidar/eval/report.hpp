@@ -9,7 +9,8 @@
 //    "ate": {"translation_m": STATS, "rotation_deg": STATS},
 //    "rpe": {"delta", "delta_unit": "frames|m", "translation_m": STATS, "translation_percent": STATS,
 //            "rotation_deg": STATS},
-//    "kitti": null | {"segments", "translation_percent", "rotation_deg_per_100m"}}
+//    "kitti": null | {"segments", "translation_percent", "rotation_deg_per_100m",
+//                     "by_length": [{"length_m", "segments", "translation_percent", "rotation_deg_per_100m"}]}}
 //   STATS = {"count", "rmse", "mean", "median", "std", "min", "max"}
 //   with --covariance: "pose_nees": {"skipped", "pose": BAND, "translation": BAND, "stamps": [...], "values": [...]}
 //   BAND = {"frames", "median", "inside", "below", "above", "band_95": [low, high]} (shares in [0, 1])

@@ -103,11 +103,10 @@ std::optional<KittiOdometryResult> compute_kitti_odometry(const std::vector<SE3>
   constexpr std::array<double, 8> kLengths = {100, 200, 300, 400, 500, 600, 700, 800};
   constexpr std::size_t kStepFrames = 10;
   const std::vector<double> distances = path_distances(gt);
-  double sum_translation = 0.0;  // sum of t_err / length
-  double sum_rotation = 0.0;     // sum of r_err / length (rad/m)
-  std::size_t segments = 0;
+  std::array<KittiLengthDrift, kLengths.size()> sums{};  // sums of t_err / length and r_err / length (rad/m)
   for (std::size_t first = 0; first < gt.size(); first += kStepFrames) {
-    for (const double length : kLengths) {
+    for (std::size_t k = 0; k < kLengths.size(); ++k) {
+      const double length = kLengths[k];
       // devkit lastFrameFromSegmentLength: first frame with dist > dist[first] + length
       const auto it = std::upper_bound(distances.begin() + static_cast<std::ptrdiff_t>(first), distances.end(), distances[first] + length);
       if (it == distances.end()) continue;
@@ -115,16 +114,26 @@ std::optional<KittiOdometryResult> compute_kitti_odometry(const std::vector<SE3>
       const SE3 delta_gt = gt[first].inverse() * gt[last];
       const SE3 delta_est = est[first].inverse() * est[last];
       const SE3 error = delta_est.inverse() * delta_gt;
-      sum_translation += error.translation().norm() / length;
-      sum_rotation += rotation_angle_rad(error.rotation()) / length;
-      ++segments;
+      sums[k].translation_percent += error.translation().norm() / length;
+      sums[k].rotation_deg_per_100m += rotation_angle_rad(error.rotation()) / length;
+      ++sums[k].segments;
     }
   }
-  if (segments == 0) return std::nullopt;
   KittiOdometryResult result;
-  result.segments = segments;
-  result.translation_percent = 100.0 * sum_translation / static_cast<double>(segments);
-  result.rotation_deg_per_100m = 100.0 * kRadToDeg * sum_rotation / static_cast<double>(segments);
+  double sum_translation = 0.0, sum_rotation = 0.0;
+  for (std::size_t k = 0; k < kLengths.size(); ++k) {
+    const KittiLengthDrift& sum = sums[k];
+    if (sum.segments == 0) continue;
+    result.segments += sum.segments;
+    sum_translation += sum.translation_percent;
+    sum_rotation += sum.rotation_deg_per_100m;
+    const auto n = static_cast<double>(sum.segments);
+    result.by_length.push_back(
+        {kLengths[k], sum.segments, 100.0 * sum.translation_percent / n, 100.0 * kRadToDeg * sum.rotation_deg_per_100m / n});
+  }
+  if (result.segments == 0) return std::nullopt;
+  result.translation_percent = 100.0 * sum_translation / static_cast<double>(result.segments);
+  result.rotation_deg_per_100m = 100.0 * kRadToDeg * sum_rotation / static_cast<double>(result.segments);
   return result;
 }
 

@@ -43,11 +43,19 @@ RpeResult compute_rpe(const std::vector<SE3>& gt, const std::vector<SE3>& est, d
 /// starts segments of 100, 200, ..., 800 m of ground-truth path; the segment
 /// ends at the first frame farther along than the length; per segment the
 /// relative-pose error is divided by the length; results are the mean over
-/// all segments. Empty when the path is shorter than 100 m.
+/// all segments, and per length (the devkit's error-against-path-length
+/// plots). Empty when the path is shorter than 100 m.
+struct KittiLengthDrift {
+  double length_m = 0.0;
+  std::size_t segments = 0;
+  double translation_percent = 0.0;
+  double rotation_deg_per_100m = 0.0;
+};
 struct KittiOdometryResult {
   std::size_t segments = 0;
-  double translation_percent = 0.0;    ///< mean t_err / length * 100
-  double rotation_deg_per_100m = 0.0;  ///< mean r_err / length, in deg per 100 m
+  double translation_percent = 0.0;         ///< mean t_err / length * 100
+  double rotation_deg_per_100m = 0.0;       ///< mean r_err / length, in deg per 100 m
+  std::vector<KittiLengthDrift> by_length;  ///< lengths with at least one segment, shortest first
 };
 std::optional<KittiOdometryResult> compute_kitti_odometry(const std::vector<SE3>& gt, const std::vector<SE3>& est);
 

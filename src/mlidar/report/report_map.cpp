@@ -2,7 +2,8 @@
 // grid coloured by the highest point in it (heights clipped to the 2nd-98th
 // percentile so a few stray points do not wash out the colours); when the map
 // carries point covariances, a second view coloured by the largest tr(Sigma)
-// in each cell (log scale, clipped likewise).
+// in each cell (log scale, clipped likewise); when it says which LiDAR saw
+// each point, a third view with each cell in its main LiDAR's colour.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -105,6 +106,45 @@ std::string trace_view(const RunData& run) {
          render_svg(chart);
 }
 
+/// Distinct colours for up to eight LiDARs (Tableau's), grey for an unknown or a ninth.
+const char* lidar_colour(std::size_t index) {
+  static constexpr std::array<const char*, 8> kColours{"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
+                                                       "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+  return index < kColours.size() ? kColours[index] : "#7f7f7f";
+}
+
+/// The third view: each cell in the colour of the LiDAR with the most points in it (metrics.json "lidars" names them).
+std::string lidar_view(const RunData& run) {
+  std::vector<std::string> names;
+  if (run.metrics.contains("lidars") && run.metrics["lidars"].is_array())
+    for (const auto& name : run.metrics["lidars"]) names.push_back(name.is_string() ? name.get<std::string>() : "?");
+  Raster raster = top_view(run.map, std::vector<float>(run.map.size(), 0.0F), [](float) { return 0.0; });  // the grid only
+  std::vector<std::array<std::uint32_t, 9>> counts(raster.colours.size(), std::array<std::uint32_t, 9>{});
+  std::vector<std::size_t> totals(9, 0);
+  for (std::size_t i = 0; i < run.map.size(); ++i) {
+    const int c = std::min(raster.columns - 1, static_cast<int>((run.map[i].x() - raster.x0) / raster.cell));
+    const int r = std::min(raster.rows - 1, static_cast<int>((run.map[i].y() - raster.y0) / raster.cell));
+    const std::size_t lidar = std::min<std::size_t>(run.map_lidars[i], 8);
+    ++counts[static_cast<std::size_t>(r) * raster.columns + c][lidar];
+    ++totals[lidar];
+  }
+  for (std::size_t cell = 0; cell < counts.size(); ++cell) {
+    const auto most = std::max_element(counts[cell].begin(), counts[cell].end());
+    raster.colours[cell] = *most == 0 ? std::string{} : std::string(lidar_colour(static_cast<std::size_t>(most - counts[cell].begin())));
+  }
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t lidar = 0; lidar < totals.size(); ++lidar) {
+    if (totals[lidar] == 0) continue;
+    const std::string name = lidar < 8 && lidar < names.size() ? names[lidar] : "unknown";
+    rows.push_back({"<span style=\"color:" + std::string(lidar_colour(lidar)) + "\">&#9632;</span> " + escape_markup(name),
+                    std::to_string(totals[lidar]),
+                    fixed(100.0 * static_cast<double>(totals[lidar]) / static_cast<double>(run.map.size()), 1)});
+  }
+  return "<p>Which LiDAR each part of the map comes from: cells in the colour of the LiDAR with the most points in them.</p>\n" +
+         html_table({"LiDAR", "map points", "share (%)"}, rows) +
+         render_svg(top_view_chart("Map, top view (the LiDAR with the most points per cell)", std::move(raster), run));
+}
+
 }  // namespace
 
 std::optional<Section> map_section(const RunData& run) {
@@ -122,6 +162,7 @@ std::optional<Section> map_section(const RunData& run) {
                      " m (<span style=\"color:" + height_colour(0.0) + "\">dark blue</span>) to " + fixed(z_hi, 2) +
                      " m (<span style=\"color:#b8a000\">yellow</span>).</p>\n" + render_svg(chart);
   if (!run.map_traces.empty() && run.map_traces.size() == run.map.size() && points.size() == run.map.size()) html += trace_view(run);
+  if (!run.map_lidars.empty() && run.map_lidars.size() == run.map.size() && points.size() == run.map.size()) html += lidar_view(run);
   return Section{"map", "Map", html};
 }
 

@@ -52,6 +52,7 @@ namespace {
 std::vector<Section> all_sections(const RunData& run) {
   std::vector<Section> sections{summary_section(run)};
   if (auto s = extrinsics_section(run)) sections.push_back(std::move(*s));
+  if (auto s = evaluation_section(run)) sections.push_back(std::move(*s));
   if (auto s = trajectory_section(run)) sections.push_back(std::move(*s));
   if (auto s = map_section(run)) sections.push_back(std::move(*s));
   if (auto s = autocalib_stages_section(run)) sections.push_back(std::move(*s));
@@ -62,16 +63,8 @@ std::vector<Section> all_sections(const RunData& run) {
 
 }  // namespace
 
-std::string render_report_html(const RunData& run) {
-  std::vector<Section> sections;
-  try {
-    sections = all_sections(run);
-  } catch (const nlohmann::json::exception& error) {  // a value of another type than the job writes
-    throw InputError((run.folder / "metrics.json").string(), "",
-                     std::string("unexpected structure (") + error.what() + "); run the job again with this version to rewrite it");
-  }
+std::string render_page(const std::string& title, const std::vector<Section>& sections) {
   std::ostringstream out;
-  const std::string title = "mlidar " + (run.command.empty() ? std::string("run") : run.command) + ": " + run.title_folder;
   out << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"generator\" content=\"mlidar report\">"
       << "<title>" << escape_markup(title) << "</title><style>" << kStyle << "</style></head>\n<body>\n<h1>" << escape_markup(title)
       << "</h1>\n<nav>";
@@ -81,6 +74,17 @@ std::string render_report_html(const RunData& run) {
     out << "<section id=\"" << s.id << "\"><h2>" << escape_markup(s.title) << "</h2>\n" << s.html << "</section>\n";
   out << "</body></html>\n";
   return out.str();
+}
+
+std::string render_report_html(const RunData& run) {
+  std::vector<Section> sections;
+  try {
+    sections = all_sections(run);
+  } catch (const nlohmann::json::exception& error) {  // a value of another type than the job writes
+    throw InputError((run.folder / "metrics.json").string(), "",
+                     std::string("unexpected structure (") + error.what() + "); run the job again with this version to rewrite it");
+  }
+  return render_page("mlidar " + (run.command.empty() ? std::string("run") : run.command) + ": " + run.title_folder, sections);
 }
 
 void write_run_report(const std::filesystem::path& folder, const ReportSource& source) {

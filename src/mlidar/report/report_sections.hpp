@@ -15,6 +15,9 @@ struct Section {
   std::string html;  ///< its body
 };
 
+/// The whole page: head with the style, the title, a link per section, the sections.
+std::string render_page(const std::string& title, const std::vector<Section>& sections);
+
 /// A table whose cells are given as HTML (escape text first).
 std::string html_table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
 
@@ -35,6 +38,8 @@ std::vector<Section> calibration_sections(const RunData& run);
 std::optional<Section> timing_section(const RunData& run);
 /// The map's top view coloured by height.
 std::optional<Section> map_section(const RunData& run);
+/// eval traj: the error statistics, the KITTI drift per segment length and the pose NEES of eval.json.
+std::optional<Section> evaluation_section(const RunData& run);
 /// calibrate auto: hand-eye's estimate, the refinement's start and its result per LiDAR.
 std::optional<Section> autocalib_stages_section(const RunData& run);
 

@@ -91,6 +91,32 @@ void calibration_verdicts(const RunData& run, std::vector<Verdict>& out) {
   }
 }
 
+/// eval traj: the error in one line, then what was not evaluated and what the covariance says.
+void evaluation_verdicts(const RunData& run, std::vector<Verdict>& out) {
+  const nlohmann::json& m = run.metrics;
+  if (!m.is_object()) return;
+  const double matched = number_of(m.value("matched_poses", nlohmann::json())), est = number_of(m.value("est_poses", nlohmann::json()));
+  const nlohmann::json ate = m.value("ate", nlohmann::json::object()).value("translation_m", nlohmann::json::object());
+  std::string text = "ATE RMSE " + fixed(number_of(ate.value("rmse", nlohmann::json())), 4) + " m (max " +
+                     fixed(number_of(ate.value("max", nlohmann::json())), 4) + " m) over " + fixed(matched, 0) + " poses";
+  const nlohmann::json kitti = m.value("kitti", nlohmann::json());
+  if (kitti.is_object())
+    text += "; KITTI drift " + fixed(number_of(kitti["translation_percent"]), 3) + " %, " +
+            fixed(number_of(kitti["rotation_deg_per_100m"]), 4) + " deg/100 m";
+  out.push_back({"ok", text});
+  if (matched < est)
+    out.push_back({"warn", fixed(est - matched, 0) + " of " + fixed(est, 0) +
+                               " estimated poses have no ground-truth pose within --max-dt and are not evaluated"});
+  if (!kitti.is_object()) out.push_back({"warn", "ground-truth path shorter than 100 m: no KITTI drift"});
+  if (m.contains("pose_nees") && m["pose_nees"].is_object()) {
+    const nlohmann::json pose = m["pose_nees"].value("pose", nlohmann::json::object());
+    const double inside = number_of(pose.value("inside", nlohmann::json())), above = number_of(pose.value("above", nlohmann::json()));
+    if (inside < 0.9)
+      out.push_back({"warn", "the pose covariance is not consistent with the error: " + fixed(100 * inside, 0) + " % of the poses inside " +
+                                 "the 95 % NEES band (" + fixed(100 * above, 0) + " % above it: covariance too small)"});
+  }
+}
+
 std::string facts(const RunData& run) {
   std::vector<std::vector<std::string>> rows;
   rows.push_back({"command", escape_markup(run.command)});
@@ -99,6 +125,8 @@ std::string facts(const RunData& run) {
     rows.push_back({"started (UTC)", escape_markup(run.run_info.value("started_utc", std::string("-")))});
     rows.push_back({"finished (UTC)", escape_markup(run.run_info.value("finished_utc", std::string("-")))});
     rows.push_back({"mlidar", escape_markup(run.run_info.value("version", std::string("-")))});
+    if (run.run_info.contains("arguments") && run.run_info["arguments"].is_array())
+      rows.push_back({"command line", "<code>" + escape_markup(joined(run.run_info["arguments"], " ")) + "</code>"});
   }
   if (run.metrics.contains("frames")) rows.push_back({"frames", escape_markup(run.metrics["frames"].dump())});
   if (run.metrics.contains("calibrate")) rows.push_back({"extrinsics", escape_markup(run.metrics.value("calibrate", std::string{}))});
@@ -125,6 +153,7 @@ Section summary_section(const RunData& run) {
   if (run.command == "slam") slam_verdicts(run, verdicts);
   if (run.command == "slam" || run.command == "odometry") frame_verdicts(run.metrics, verdicts);
   if (run.command == "calibrate auto") calibration_verdicts(run, verdicts);
+  if (run.command == "eval traj") evaluation_verdicts(run, verdicts);
   if (verdicts.empty()) verdicts.push_back({"ok", "nothing flagged"});
   std::ostringstream html;
   html << "<ul class=\"verdicts\">\n";

@@ -26,7 +26,35 @@ std::vector<double> positions(const std::vector<SE3>& poses, int axis) {
   return out;
 }
 
-Chart view(const std::string& title, int horizontal, int vertical, const std::vector<SE3>& estimate, const std::vector<SE3>* truth) {
+/// "SE(3)-aligned" and the like.
+std::string aligned_words(eval::AlignMode mode) {
+  switch (mode) {
+    case eval::AlignMode::kNone:
+      return "not aligned";
+    case eval::AlignMode::kOrigin:
+      return "first poses aligned";
+    case eval::AlignMode::kSe3:
+      return "SE(3)-aligned";
+    case eval::AlignMode::kSim3:
+      return "Sim(3)-aligned";
+  }
+  return "aligned";
+}
+
+/// The estimate's legend: "estimate (aligned, SE(3))" and the like.
+std::string alignment_words(eval::AlignMode mode) {
+  switch (mode) {
+    case eval::AlignMode::kSe3:
+      return "estimate (aligned, SE(3))";
+    case eval::AlignMode::kSim3:
+      return "estimate (aligned, Sim(3))";
+    default:
+      return "estimate (" + aligned_words(mode) + ")";
+  }
+}
+
+Chart view(const std::string& title, int horizontal, int vertical, const std::vector<SE3>& estimate, const std::vector<SE3>* truth,
+           eval::AlignMode align) {
   static const char* const kNames[] = {"x (m)", "y (m)", "z (m)"};
   Chart chart;
   chart.title = title;
@@ -36,7 +64,7 @@ Chart view(const std::string& title, int horizontal, int vertical, const std::ve
   chart.width = 640;
   chart.height = 480;
   if (truth != nullptr) chart.series.push_back({"ground truth", kTruthColour, positions(*truth, horizontal), positions(*truth, vertical)});
-  chart.series.push_back({truth != nullptr ? "estimate (aligned, SE(3))" : "estimate", kEstimateColour, positions(estimate, horizontal),
+  chart.series.push_back({truth != nullptr ? alignment_words(align) : "estimate", kEstimateColour, positions(estimate, horizontal),
                           positions(estimate, vertical)});
   return chart;
 }
@@ -84,6 +112,16 @@ std::string uncertainty_words(const RunData& run, const std::optional<eval::Traj
   return html.str();
 }
 
+/// SE(3) alignment, or the one an `eval traj` run used (its eval.json).
+eval::TrajectoryEvalOptions evaluation_options(const RunData& run) {
+  eval::TrajectoryEvalOptions options;
+  if (run.command != "eval traj" || !run.metrics.is_object() || !run.metrics.contains("alignment")) return options;
+  const std::string mode = run.metrics["alignment"].value("mode", std::string{});
+  for (const eval::AlignMode m : {eval::AlignMode::kNone, eval::AlignMode::kOrigin, eval::AlignMode::kSe3, eval::AlignMode::kSim3})
+    if (mode == eval::align_mode_name(m)) options.align = m;
+  return options;
+}
+
 }  // namespace
 
 std::optional<Section> trajectory_section(const RunData& run) {
@@ -92,10 +130,10 @@ std::optional<Section> trajectory_section(const RunData& run) {
   for (const StampedPose& p : run.trajectory->poses) estimate.push_back(p.T_world_base);
   std::ostringstream html;
   std::optional<eval::TrajectoryReport> evaluated;
+  const eval::TrajectoryEvalOptions options = evaluation_options(run);
   if (run.gt_trajectory) {
     try {
-      evaluated = eval::evaluate_trajectory(*run.gt_trajectory, *run.trajectory, eval::TrajectoryEvalOptions{},
-                                            "groundtruth/trajectory.tum", "trajectory.tum");
+      evaluated = eval::evaluate_trajectory(*run.gt_trajectory, *run.trajectory, options, "groundtruth/trajectory.tum", "trajectory.tum");
     } catch (const std::exception& error) {
       html << "<p class=\"note\">Not compared with the ground truth: " << escape_markup(error.what()) << "</p>\n";
     }
@@ -103,11 +141,12 @@ std::optional<Section> trajectory_section(const RunData& run) {
   const std::vector<SE3>& shown = evaluated ? evaluated->est_aligned : estimate;
   const std::vector<SE3>* truth = evaluated ? &evaluated->gt : nullptr;
   if (evaluated)
-    html << "<p>ATE (SE(3)-aligned) RMSE " << fixed(evaluated->ate.translation_m.rmse, 4) << " m, max "
+    html << "<p>ATE (" << aligned_words(options.align) << ") RMSE " << fixed(evaluated->ate.translation_m.rmse, 4) << " m, max "
          << fixed(evaluated->ate.translation_m.max, 4) << " m; rotation RMSE " << fixed(evaluated->ate.rotation_deg.rmse, 3)
          << "&deg; over " << evaluated->gt.size() << " poses.</p>\n";
   html << "<div class=\"figures\">\n"
-       << render_svg(view("Top view", 0, 1, shown, truth)) << render_svg(view("Side view", 0, 2, shown, truth));
+       << render_svg(view("Top view", 0, 1, shown, truth, options.align))
+       << render_svg(view("Side view", 0, 2, shown, truth, options.align));
   if (evaluated && !evaluated->stamps.empty()) {
     Chart error;
     error.title = "Translation error over time (ATE)";

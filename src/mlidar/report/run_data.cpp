@@ -49,7 +49,8 @@ std::optional<T> read_optional(const fs::path& path, Read read, std::vector<std:
 
 struct MapPoints {
   std::vector<Eigen::Vector3f> points;
-  std::vector<float> traces;  ///< one per point, or empty
+  std::vector<float> traces;         ///< one per point, or empty
+  std::vector<std::uint8_t> lidars;  ///< one per point, or empty
 };
 
 /// map.ply's points and, when it has them, their covariances' traces (a map with covariances has only finite points).
@@ -59,6 +60,10 @@ MapPoints read_map(const fs::path& path) {
   if (const auto covariances = io::read_point_covariances(cloud.table, path.string());
       covariances && covariances->size() == map.points.size())
     for (const io::UpperCovariance& c : *covariances) map.traces.push_back(c[0] + c[3] + c[5]);
+  // The LiDAR of each point, kept only when every point has a position (to_scan keeps the finite ones).
+  if (const io::FieldColumn* lidar = cloud.table.find("lidar");
+      lidar != nullptr && lidar->type == io::ScalarType::kU8 && cloud.table.num_points == map.points.size())
+    for (std::size_t i = 0; i < cloud.table.num_points; ++i) map.lidars.push_back(static_cast<std::uint8_t>(lidar->value(i)));
   return map;
 }
 
@@ -84,10 +89,11 @@ RunData load_run(const fs::path& folder, const ReportSource& source) {
   run.command = !command.empty() || run.run_info.is_null() ? command : run.run_info.value("command", std::string{});
   if (run.run_info.is_null() && command.empty())
     throw InputError((folder / "run.json").string(), "", "missing: this is not an mlidar run folder (give the --out of a job)");
-  if (is_file(folder / "metrics.json"))
-    run.metrics = read_json(folder / "metrics.json");
-  else if (is_file(folder / "calibration.json"))
-    run.metrics = read_json(folder / "calibration.json");
+  for (const char* name : {"metrics.json", "calibration.json", "eval.json"})  // slam/odometry, calibrate auto, eval traj
+    if (is_file(folder / name)) {
+      run.metrics = read_json(folder / name);
+      break;
+    }
   run.trajectory = read_optional<Trajectory>(
       folder / "trajectory.tum", [](const fs::path& p) { return io::read_tum(p); }, run.notes);
   if (auto covariances = read_optional<std::vector<io::StampedCovariance>>(
@@ -98,8 +104,14 @@ RunData load_run(const fs::path& folder, const ReportSource& source) {
   if (auto map = read_optional<MapPoints>(folder / "map.ply", read_map, run.notes)) {
     run.map = std::move(map->points);
     run.map_traces = std::move(map->traces);
+    run.map_lidars = std::move(map->lidars);
   }
   run.dataset = !source.dataset.empty() ? source.dataset.string() : dataset_argument(run.run_info);
+  if (is_file(folder / "groundtruth.tum")) {  // eval traj: the ground truth it was given, associated
+    run.gt_trajectory = read_optional<Trajectory>(
+        folder / "groundtruth.tum", [](const fs::path& p) { return io::read_tum(p); }, run.notes);
+    return run;
+  }
   if (run.dataset.empty()) return run;
   const fs::path truth = fs::path(run.dataset) / "groundtruth";
   if (!fs::is_directory(truth, error)) {

@@ -8,6 +8,7 @@
 // extrinsic with its 1-sigma and weak directions, the error and NEES against
 // ground truth), and the time per stage. Written by the jobs at the end of a
 // run and again by `mlidar report RUN`.
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -29,13 +30,14 @@ struct RunData {
   std::string command;       ///< "slam", "calibrate auto", "odometry", ...
   std::string dataset;       ///< as given to the job; empty when unknown
   nlohmann::json run_info;   ///< run.json (null before the run is committed)
-  nlohmann::json metrics;    ///< metrics.json or calibration.json (null when absent)
+  nlohmann::json metrics;    ///< metrics.json, calibration.json or eval.json (null when absent)
   std::optional<Trajectory> trajectory;
   std::vector<io::StampedCovariance> pose_covariances;  ///< pose_covariance.txt (empty when absent)
   std::optional<io::Extrinsics> extrinsics;
   std::vector<Eigen::Vector3f> map;             ///< map.ply's points (empty when absent)
   std::vector<float> map_traces;                ///< tr(Sigma) of each map point when map.ply carries covariances, else empty
-  std::optional<Trajectory> gt_trajectory;      ///< DATASET/groundtruth/trajectory.tum
+  std::vector<std::uint8_t> map_lidars;         ///< each map point's LiDAR (index into metrics.json "lidars") when map.ply says, else empty
+  std::optional<Trajectory> gt_trajectory;      ///< FOLDER/groundtruth.tum (eval traj), else DATASET/groundtruth/trajectory.tum
   std::optional<io::Extrinsics> gt_extrinsics;  ///< DATASET/groundtruth/extrinsics.yaml
   std::vector<std::string> notes;               ///< what could not be read, in words
 };
