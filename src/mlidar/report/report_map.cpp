@@ -106,10 +106,10 @@ std::string trace_view(const RunData& run) {
          render_svg(chart);
 }
 
-/// Distinct colours for up to eight LiDARs (Tableau's), grey for an unknown or a ninth.
+/// Distinct colours for up to eight LiDARs (Tableau's, without its red: the trajectory is red), grey for an unknown or a ninth.
 const char* lidar_colour(std::size_t index) {
-  static constexpr std::array<const char*, 8> kColours{"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
-                                                       "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+  static constexpr std::array<const char*, 8> kColours{"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd",
+                                                       "#8c564b", "#e377c2", "#17becf", "#bcbd22"};
   return index < kColours.size() ? kColours[index] : "#7f7f7f";
 }
 
