@@ -70,14 +70,7 @@ Raster overlay(const std::vector<Eigen::Vector3f>& ref, const std::vector<Eigen:
 }
 
 Chart overlay_chart(const std::string& title, Raster raster, int horizontal, int vertical) {
-  static const char* const kNames[] = {"x (m)", "y (m)", "z (m)"};
-  Chart chart;
-  chart.title = title;
-  chart.x_label = kNames[horizontal];
-  chart.y_label = kNames[vertical];
-  chart.equal_axes = true;
-  chart.width = 640;
-  chart.height = 480;
+  Chart chart = spatial_view(title, horizontal, vertical);
   chart.raster = std::move(raster);
   return chart;
 }

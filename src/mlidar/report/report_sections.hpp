@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "mlidar/report/run_report.hpp"
+#include "mlidar/report/svg_chart.hpp"
 
 namespace mlidar::report {
 
@@ -17,6 +18,9 @@ struct Section {
 
 /// The whole page: head with the style, the title, a link per section, the sections.
 std::string render_page(const std::string& title, const std::vector<Section>& sections);
+
+/// A 640 x 480 chart with equal axes over axes `horizontal` and `vertical` (0 x, 1 y, 2 z, in m): a top or side view.
+Chart spatial_view(const std::string& title, int horizontal, int vertical);
 
 /// A table whose cells are given as HTML (escape text first).
 std::string html_table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);

@@ -55,14 +55,7 @@ std::string alignment_words(eval::AlignMode mode) {
 
 Chart view(const std::string& title, int horizontal, int vertical, const std::vector<SE3>& estimate, const std::vector<SE3>* truth,
            eval::AlignMode align) {
-  static const char* const kNames[] = {"x (m)", "y (m)", "z (m)"};
-  Chart chart;
-  chart.title = title;
-  chart.x_label = kNames[horizontal];
-  chart.y_label = kNames[vertical];
-  chart.equal_axes = true;
-  chart.width = 640;
-  chart.height = 480;
+  Chart chart = spatial_view(title, horizontal, vertical);
   if (truth != nullptr) chart.series.push_back({"ground truth", kTruthColour, positions(*truth, horizontal), positions(*truth, vertical)});
   chart.series.push_back({truth != nullptr ? alignment_words(align) : "estimate", kEstimateColour, positions(estimate, horizontal),
                           positions(estimate, vertical)});
@@ -123,6 +116,18 @@ eval::TrajectoryEvalOptions evaluation_options(const RunData& run) {
 }
 
 }  // namespace
+
+Chart spatial_view(const std::string& title, int horizontal, int vertical) {
+  static const char* const kNames[] = {"x (m)", "y (m)", "z (m)"};
+  Chart chart;
+  chart.title = title;
+  chart.x_label = kNames[horizontal];
+  chart.y_label = kNames[vertical];
+  chart.equal_axes = true;
+  chart.width = 640;
+  chart.height = 480;
+  return chart;
+}
 
 std::optional<Section> trajectory_section(const RunData& run) {
   if (!run.trajectory || run.trajectory->empty()) return std::nullopt;
