@@ -212,7 +212,8 @@ Scan to_scan(const PointTable& table, const std::string& source, const ScanOptio
 
 void add_f32_field(PointTable& table, const std::string& name, std::span<const float> values) {
   if (values.size() != table.num_points) throw std::invalid_argument("add_f32_field: one value per point for " + name);
-  std::memcpy(table.add_field(name, ScalarType::kF32).data.data(), values.data(), values.size() * sizeof(float));
+  FieldColumn& column = table.add_field(name, ScalarType::kF32);
+  if (!values.empty()) std::memcpy(column.data.data(), values.data(), values.size() * sizeof(float));
 }
 
 PointTable from_scan(const Scan& scan) {

@@ -248,7 +248,7 @@ void write_map_ply(const std::filesystem::path& path, const MapCloud& map) {
   if (map.covariances) io::add_point_covariances(cloud.table, *map.covariances);
   if (map.lidars.size() == map.points.size() && !map.lidar_names.empty()) {
     io::FieldColumn& column = cloud.table.add_field("lidar", io::ScalarType::kU8);
-    std::memcpy(column.data.data(), map.lidars.data(), map.lidars.size());
+    if (!map.lidars.empty()) std::memcpy(column.data.data(), map.lidars.data(), map.lidars.size());
   }
   io::write_cloud(path, cloud);
 }

@@ -133,7 +133,7 @@ io::PointTable fused_cloud(const io::SourceFrame& frame, const std::vector<Pertu
   }
   io::PointTable table = io::from_scan(fused);
   io::FieldColumn& lidar = table.add_field("lidar", io::ScalarType::kU8);
-  std::memcpy(lidar.data.data(), lidar_index.data(), lidar_index.size());
+  if (!lidar_index.empty()) std::memcpy(lidar.data.data(), lidar_index.data(), lidar_index.size());
   io::add_f32_field(table, "uncertainty", uncertainty);
   return table;
 }
