@@ -21,16 +21,4 @@ void add_bag_options(CLI::App& sub, BagCliOptions& options, bool with_bag, bool 
   sub.add_option("--duration", options.duration_s, "Seconds of the bag to read (default: to the end)")->check(CLI::Range(0.0, 1e9));
 }
 
-io::BagSourceOptions bag_source_options(const BagCliOptions& options) {
-  io::BagSourceOptions out;
-  if (!options.topics.empty()) out.topics = io::parse_bag_topics(options.topics);
-  out.base = options.base;
-  out.stamp_at = options.stamp_at == "start" ? io::StampAt::kStart : options.stamp_at == "end" ? io::StampAt::kEnd : io::StampAt::kAuto;
-  out.start_s = options.start_s;
-  if (options.duration_s > 0.0) out.duration_s = options.duration_s;
-  if (!options.extrinsics.empty()) out.extrinsics = io::read_extrinsics(options.extrinsics);
-  if (!options.models.empty()) out.models = io::read_dataset_yaml(options.models);
-  return out;
-}
-
 }  // namespace mlidar::cli

@@ -1,7 +1,6 @@
 // `mlidar calibrate planes`: PS-Calib (thesis Chap. 2) from one scan of each
 // LiDAR looking at a wall corner. `mlidar calibrate auto`: Auto-Calib (thesis
 // Chap. 3) from a dataset folder's motion. `calibrate` is the parent of the solvers.
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,11 +8,8 @@
 #include <memory>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "apps/mlidar/bag_options.hpp"
 #include "apps/mlidar/commands.hpp"
-#include "apps/mlidar/planes_config_yaml.hpp"
 #include "mlidar/calib/planes_calibrator.hpp"
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/core/error.hpp"
@@ -23,13 +19,12 @@
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/pipelines/autocalib_config.hpp"
 #include "mlidar/pipelines/autocalib_job.hpp"
+#include "mlidar/pipelines/planes_job.hpp"
 #include "mlidar/report/pair_report.hpp"
 #include "mlidar/report/run_report.hpp"
 
 namespace mlidar::cli {
 namespace {
-
-namespace fs = std::filesystem;
 
 struct PlanesOptions {
   std::string ref;
@@ -42,75 +37,20 @@ struct PlanesOptions {
   bool strict = false;
 };
 
-std::string lidar_name(const std::string& path, const std::string& fallback) {
-  const std::string stem = fs::path(path).stem().string();
-  return stem.empty() ? fallback : stem;
-}
-
-/// T_ref_target from an extrinsics file that names both LiDARs (or whose base is the reference).
-SE3 read_guess(const std::string& path, const std::string& ref_name, const std::string& target_name) {
-  const io::Extrinsics extrinsics = io::read_extrinsics(path);
-  const io::LidarExtrinsic* target = extrinsics.find(target_name);
-  if (target == nullptr) throw InputError(path, "lidars." + target_name, "missing; --init must name the target LiDAR");
-  const io::LidarExtrinsic* ref = extrinsics.find(ref_name);
-  if (ref == nullptr && extrinsics.base != ref_name)
-    throw InputError(path, "lidars." + ref_name, "missing; --init must name the reference LiDAR or use it as base");
-  return ref == nullptr ? target->T_base_lidar : ref->T_base_lidar.inverse() * target->T_base_lidar;
-}
-
-nlohmann::json pose_json(const SE3& T) {
-  const Quat& q = T.rotation();
-  return {{"translation", {T.translation().x(), T.translation().y(), T.translation().z()}},
-          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
-}
-
-nlohmann::json cloud_json(const calib::CloudCornerReport& cloud) {
-  nlohmann::json planes = nlohmann::json::array();
-  const char* names[3] = {"left", "right", "bottom"};
-  for (int i = 0; i < 3; ++i) {
-    const auto& p = cloud.planes[i];
-    planes.push_back({{"name", names[i]},
-                      {"normal", {p.plane.normal.x(), p.plane.normal.y(), p.plane.normal.z()}},
-                      {"offset", p.plane.offset},
-                      {"inliers", p.inliers},
-                      {"residual_rms_m", p.residual_rms}});
-  }
-  return {{"planes_found", cloud.planes_found},
-          {"planes", planes},
-          {"angles_deg", {cloud.angles_deg[0], cloud.angles_deg[1], cloud.angles_deg[2]}},
-          {"corner", {cloud.corner.x(), cloud.corner.y(), cloud.corner.z()}}};
-}
-
-nlohmann::json report_json(const calib::PlanesResult& result, double seconds) {
-  nlohmann::json warnings = nlohmann::json::array();
-  for (const auto w : result.warnings) warnings.push_back(calib::warning_name(w));
-  std::vector<double> covariance(result.covariance.data(), result.covariance.data() + 36);  // symmetric
-  return {{"verdict", result.ok() ? "ok" : "warning"},
-          {"warnings", warnings},
-          {"T_ref_target", pose_json(result.T_ref_target)},
-          {"T_ref_target_closed_form", pose_json(result.T_ref_target_closed_form)},
-          {"covariance", covariance},
-          {"residual_sigma_m", result.residual_sigma},
-          {"rotation_sigma_max_deg", result.rotation_sigma_max_deg},
-          {"iterations", result.iterations},
-          {"converged", result.converged},
-          {"seconds", seconds},
-          {"ref", cloud_json(result.ref)},
-          {"target", cloud_json(result.target)}};
-}
-
-void write_planes_html(const PlanesOptions& options, const std::string& ref_name, const std::string& target_name, const Scan& ref,
-                       const Scan& target, const std::optional<SE3>& guess, const calib::PlanesResult& result, double seconds) {
+void write_planes_html(const PlanesOptions& options, const pipelines::PlanesJobResult& job) {
+  const calib::PlanesResult& result = job.result;
+  const std::string& ref_name = job.ref_name;
+  const std::string& target_name = job.target_name;
   report::PairCalibration pair;
   pair.command = "calibrate planes";
   pair.ref_name = ref_name;
   pair.target_name = target_name;
   pair.ref_file = options.ref;
   pair.target_file = options.target;
-  pair.ref_points = ref.points;
-  pair.target_points = target.points;
-  pair.T_ref_target_before = guess.value_or(SE3());
-  pair.before_words = guess ? "the --init guess" : "identity (no --init: the clouds as recorded)";
+  pair.ref_points = job.ref.points;
+  pair.target_points = job.target.points;
+  pair.T_ref_target_before = job.guess.value_or(SE3());
+  pair.before_words = job.guess ? "the --init guess" : "identity (no --init: the clouds as recorded)";
   pair.T_ref_target = result.T_ref_target;
   pair.covariance = result.covariance;
   pair.verdict_level = result.ok() ? "ok" : "warn";
@@ -126,7 +66,7 @@ void write_planes_html(const PlanesOptions& options, const std::string& ref_name
                   cloud->angles_deg[1], cloud->angles_deg[2]);
     pair.facts.emplace_back(cloud == &result.ref ? ref_name : target_name, text);
   }
-  std::snprintf(text, sizeof text, "%.2f s", seconds);
+  std::snprintf(text, sizeof text, "%.2f s", job.seconds);
   pair.facts.emplace_back("time", text);
   const std::string html = report::render_pair_calibration_html(pair);
   io::write_atomically(options.html, [&](std::ostream& out) { out << html; });
@@ -136,33 +76,17 @@ int run_planes(const PlanesOptions& options) {
   io::check_output_file(options.out, "--out");
   if (!options.report.empty()) io::check_output_file(options.report, "--report");
   if (!options.html.empty()) io::check_output_file(options.html, "--html");
-  const std::string ref_name = lidar_name(options.ref, "ref");
-  std::string target_name = lidar_name(options.target, "target");
-  if (target_name == ref_name) target_name = "target";
-  calib::PlanesConfig config;
-  if (!options.config.empty()) config = parse_planes_config(io::read_file_text(options.config), options.config);
-  const calib::PlanesCalibrator calibrator(config);
-  std::optional<SE3> guess;
-  if (!options.init.empty()) guess = read_guess(options.init, ref_name, target_name);
-  const Scan ref = io::to_scan(io::read_cloud(options.ref).table, options.ref);
-  const Scan target = io::to_scan(io::read_cloud(options.target).table, options.target);
-
-  const auto start = std::chrono::steady_clock::now();
-  const calib::PlanesResult result = calibrator.calibrate(ref.points, target.points, guess, options.ref, options.target);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  io::Extrinsics extrinsics;
-  extrinsics.base = ref_name;
-  extrinsics.lidars = {{ref_name, SE3(), std::nullopt}, {target_name, result.T_ref_target, result.covariance}};
-  io::write_extrinsics(options.out, extrinsics);
+  const pipelines::PlanesJobResult job = pipelines::run_planes_job({options.ref, options.target, options.init, options.config});
+  const calib::PlanesResult& result = job.result;
+  io::write_extrinsics(options.out, pipelines::planes_extrinsics(job));
   if (!options.report.empty()) {
-    const std::string text = report_json(result, seconds).dump(2);
+    const std::string text = pipelines::planes_report_json(job).dump(2);
     io::write_atomically(options.report, [&](std::ostream& out) { out << text << '\n'; });
   }
-  if (!options.html.empty()) write_planes_html(options, ref_name, target_name, ref, target, guess, result, seconds);
+  if (!options.html.empty()) write_planes_html(options, job);
   const Vec3& t = result.T_ref_target.translation();
   std::cout << "T_ref_target t = [" << t.x() << ", " << t.y() << ", " << t.z() << "] m, residual sigma " << result.residual_sigma << " m, "
-            << result.iterations << " iterations, " << seconds << " s\n";
+            << result.iterations << " iterations, " << job.seconds << " s\n";
   std::cout << "verdict: " << (result.ok() ? "ok" : "warning");
   for (const auto w : result.warnings) std::cout << ' ' << calib::warning_name(w);
   std::cout << '\n';

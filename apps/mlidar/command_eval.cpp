@@ -10,14 +10,13 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/eval/report.hpp"
 #include "mlidar/eval/svg_plot.hpp"
+#include "mlidar/eval/trajectory_files.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
 #include "mlidar/io/point_covariance_fields.hpp"
-#include "mlidar/io/pose_covariance_io.hpp"
 #include "mlidar/io/surface_samples.hpp"
-#include "mlidar/io/trajectory_io.hpp"
-#include "mlidar/report/run_report.hpp"
+#include "mlidar/report/eval_run.hpp"
 
 namespace mlidar::cli {
 namespace {
@@ -57,72 +56,30 @@ void write_json(const std::string& path, const nlohmann::json& json) {
   io::write_atomically(path, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
 }
 
-eval::AlignMode parse_align(const std::string& name) {
-  if (name == "none") return eval::AlignMode::kNone;
-  if (name == "origin") return eval::AlignMode::kOrigin;
-  if (name == "se3") return eval::AlignMode::kSe3;
-  return eval::AlignMode::kSim3;  // CLI11 restricts the choices
-}
-
-/// KITTI pose files by `--format kitti` or a .kitti extension; TUM otherwise.
-bool is_kitti_format(const TrajOptions& options) {
-  if (!options.format.empty()) return options.format == "kitti";
-  return std::filesystem::path(options.gt).extension() == ".kitti";
-}
-
-Trajectory read_trajectory(const std::string& path, bool kitti) { return kitti ? io::read_kitti_poses(path) : io::read_tum(path); }
-
-/// Poses stamped with the ground truth's stamps of their association (a KITTI file's poses get its index stamps).
-Trajectory stamped(const std::vector<SE3>& poses, const std::vector<double>& stamps) {
-  Trajectory out;
-  for (std::size_t i = 0; i < poses.size(); ++i) out.poses.push_back({stamps[i], poses[i]});
-  return out;
-}
-
-/// `--out RUN`: eval.json, the associated pairs as groundtruth.tum / trajectory.tum (the estimate before alignment,
-/// at the ground truth's stamps, so the report re-associates them exactly) and report.html, committed together.
-void write_eval_run(const TrajOptions& options, const CliContext& context, const eval::TrajectoryReport& report,
-                    const nlohmann::json& json) {
-  std::vector<std::filesystem::path> inputs{options.gt, options.est};
-  if (!options.covariance.empty()) inputs.emplace_back(options.covariance);
-  io::RunFolder run(options.out, "eval traj", context.run_folder(options.overwrite, inputs));
-  write_json((run / "eval.json").string(), json);
-  io::write_tum(run / "groundtruth.tum", stamped(report.gt, report.stamps));
-  io::write_tum(run / "trajectory.tum", stamped(report.est, report.stamps));
-  report::write_run_report(run.path(), {"eval traj", {}, options.out});
-  run.commit();
-  std::cout << "wrote " << options.out << " (eval.json, report.html)\n";
-}
-
 int run_traj(const TrajOptions& options, const CliContext& context) {
   if (!options.json_out.empty()) io::check_output_file(options.json_out, "--json");
   if (!options.plot_out.empty()) io::check_output_file(options.plot_out, "--plot");
-  const bool kitti = is_kitti_format(options);
   eval::TrajectoryEvalOptions eval_options;
-  eval_options.align = parse_align(options.align);
-  eval_options.associate_by_index = kitti;
+  eval_options.align = eval::parse_align_mode(options.align);
   eval_options.max_dt = options.max_dt;
   eval_options.delta = options.delta;
   eval_options.delta_unit = options.delta_unit == "m" ? eval::DeltaUnit::kMeters : eval::DeltaUnit::kFrames;
-  const Trajectory gt = read_trajectory(options.gt, kitti);
-  const Trajectory est = read_trajectory(options.est, kitti);
-  const eval::TrajectoryReport report = eval::evaluate_trajectory(gt, est, eval_options, options.gt, options.est);
+  const eval::TrajectoryFileEvaluation evaluation =
+      eval::evaluate_trajectory_files({options.gt, options.est, options.format, options.covariance}, eval_options);
+  const eval::TrajectoryReport& report = evaluation.report;
   std::cout << eval::format_table(report);
-  nlohmann::json json = eval::to_json(report);
-  if (!options.covariance.empty()) {
-    const std::vector<io::StampedCovariance> covariances = io::read_pose_covariances(options.covariance);
-    std::vector<double> est_stamps;
-    for (const StampedPose& pose : est.poses) est_stamps.push_back(pose.stamp);
-    const eval::PoseNees nees = eval::evaluate_pose_nees(report, covariances, options.covariance, est_stamps);
-    std::cout << eval::format_table(nees);
-    json["pose_nees"] = eval::to_json(nees);
-  }
-  write_json(options.json_out, json);
+  if (evaluation.nees) std::cout << eval::format_table(*evaluation.nees);
+  write_json(options.json_out, evaluation.json);
   if (!options.plot_out.empty()) {
     const std::string svg = eval::trajectory_plot_svg(report.gt, report.est_aligned, report.stamps, report.ate.translation_errors_m);
     io::write_atomically(options.plot_out, [&](std::ostream& out) { out << svg; });
   }
-  if (!options.out.empty()) write_eval_run(options, context, report, json);
+  if (!options.out.empty()) {
+    std::vector<std::filesystem::path> inputs{options.gt, options.est};
+    if (!options.covariance.empty()) inputs.emplace_back(options.covariance);
+    report::write_eval_run(options.out, evaluation, context.run_folder(options.overwrite, inputs));
+    std::cout << "wrote " << options.out << " (eval.json, report.html)\n";
+  }
   return 0;
 }
 

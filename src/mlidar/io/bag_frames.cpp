@@ -335,4 +335,18 @@ FrameSource FrameSource::bag(const std::filesystem::path& path, const BagSourceO
   return source;
 }
 
+BagSourceOptions bag_source_options(const BagArguments& arguments) {
+  BagSourceOptions out;
+  if (!arguments.topics.empty()) out.topics = parse_bag_topics(arguments.topics);
+  out.base = arguments.base;
+  if (arguments.stamp_at != "auto" && arguments.stamp_at != "start" && arguments.stamp_at != "end")
+    throw UsageError("--stamp-at is '" + arguments.stamp_at + "': use auto, start or end");
+  out.stamp_at = arguments.stamp_at == "start" ? StampAt::kStart : arguments.stamp_at == "end" ? StampAt::kEnd : StampAt::kAuto;
+  out.start_s = arguments.start_s;
+  if (arguments.duration_s > 0.0) out.duration_s = arguments.duration_s;
+  if (!arguments.extrinsics.empty()) out.extrinsics = read_extrinsics(arguments.extrinsics);
+  if (!arguments.models.empty()) out.models = read_dataset_yaml(arguments.models);
+  return out;
+}
+
 }  // namespace mlidar::io

@@ -49,6 +49,21 @@ struct BagSourceOptions {
   std::optional<Dataset> models;         ///< LiDAR models by name
 };
 
+/// A bag's options as the command line (and the Python module) write them: names and files, not yet read.
+struct BagArguments {
+  std::string bag;
+  std::string topics;             ///< /a:top,/b:front
+  std::string base;               ///< the base LiDAR (default: the first of topics)
+  std::string stamp_at = "auto";  ///< auto, start or end (anything else: UsageError)
+  std::string extrinsics;         ///< YAML; default /tf_static
+  std::string models;             ///< a dataset.yaml naming the LiDARs' models
+  double start_s = 0.0;
+  double duration_s = 0.0;  ///< 0: to the end
+};
+
+/// The frame source's options, the files they name read (InputError naming a bad one).
+BagSourceOptions bag_source_options(const BagArguments& arguments);
+
 /// "/a:top,/b:front" -> topics; UsageError naming --topics otherwise.
 std::vector<BagLidarTopic> parse_bag_topics(const std::string& text);
 

@@ -1,4 +1,4 @@
-#include "apps/mlidar/planes_config_yaml.hpp"
+#include "mlidar/pipelines/planes_config.hpp"
 
 #include <cmath>
 #include <functional>
@@ -7,7 +7,7 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/io/yaml_fields.hpp"
 
-namespace mlidar::cli {
+namespace mlidar::pipelines {
 namespace {
 
 constexpr double kMaxCount = 1e9;
@@ -65,4 +65,4 @@ calib::PlanesConfig parse_planes_config(const std::string& yaml_text, const std:
   return config;
 }
 
-}  // namespace mlidar::cli
+}  // namespace mlidar::pipelines
