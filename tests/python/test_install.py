@@ -1,0 +1,30 @@
+"""`cmake --install` gives a package that imports from the prefix alone (a standard site-packages layout)."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+
+@pytest.mark.skipif("MLIDAR_BUILD_DIR" not in os.environ, reason="run by ctest, which names the build folder")
+def test_the_installed_package_imports_and_reads_a_cloud_from_the_prefix(tmp_path):
+    prefix = tmp_path / "prefix"
+    subprocess.run(["cmake", "--install", os.environ["MLIDAR_BUILD_DIR"], "--prefix", str(prefix)], check=True,
+                   capture_output=True)
+    site = prefix / os.environ["MLIDAR_PYTHON_INSTALL_DIR"]
+    assert (site / "mlidar" / "__init__.py").exists() and (site / "mlidar" / "_mlidar.pyi").exists()
+    assert (prefix / "bin" / "mlidar").exists()
+    script = (
+        "import numpy as np, mlidar, sys\n"
+        "assert mlidar.__file__.startswith(sys.argv[1]), mlidar.__file__\n"
+        "xyz = {a: np.arange(4, dtype=np.float32) for a in 'xyz'}\n"
+        "mlidar.write_cloud(sys.argv[2], xyz)\n"
+        "print(mlidar.read_cloud(sys.argv[2])['z'].tolist())\n"
+    )
+    environment = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    environment["PYTHONPATH"] = str(site)
+    result = subprocess.run([sys.executable, "-c", script, str(site), str(tmp_path / "c.ply")], env=environment,
+                            capture_output=True, text=True, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[0.0, 1.0, 2.0, 3.0]"
