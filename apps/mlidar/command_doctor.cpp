@@ -24,32 +24,15 @@ struct DoctorOptions {
   std::string json_out;
 };
 
-nlohmann::json findings_json(const std::vector<pipelines::Finding>& findings) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& f : findings)
-    out.push_back({{"check", f.check}, {"lidar", f.lidar}, {"severity", pipelines::to_string(f.severity)}, {"message", f.message}});
-  return out;
-}
-
 int run_doctor(const DoctorOptions& options) {
   if (!options.json_out.empty()) io::check_output_file(options.json_out, "--json");
-  const bool folder = std::filesystem::is_directory(options.input);
-  BagCliOptions bag = options.bag;
-  bag.bag = folder ? std::string{} : options.input;
-  std::vector<pipelines::Finding> findings;
-  try {
-    const io::FrameSource source =
-        pipelines::open_frames(folder ? std::filesystem::path(options.input) : std::filesystem::path{}, bag.bag, bag_source_options(bag));
-    findings = pipelines::examine(source);
-  } catch (const InputError& error) {  // what every job would stop at before its first frame
-    findings.push_back({"open", "", pipelines::Severity::kFailure, error.what()});
-  }
+  const std::vector<pipelines::Finding> findings = pipelines::examine_input(options.input, options.bag);
   for (const auto& f : findings)
     std::cout << pipelines::to_string(f.severity) << "  " << f.check << (f.lidar.empty() ? "" : " " + f.lidar) << ": " << f.message << '\n';
   const bool failed = pipelines::has_failure(findings);
   std::cout << (failed ? "a run would fail: fix the failures above\n" : "no failure found\n");
   if (!options.json_out.empty()) {
-    const nlohmann::json json = {{"input", options.input}, {"failed", failed}, {"findings", findings_json(findings)}};
+    const nlohmann::json json = pipelines::doctor_json(options.input, findings);
     io::write_atomically(options.json_out, [&](std::ostream& out) { out << json.dump(2) << '\n'; });
   }
   return failed ? 1 : 0;

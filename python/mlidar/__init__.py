@@ -39,6 +39,7 @@ __all__ = [
     "__version__",
     "calibrate_auto",
     "calibrate_planes",
+    "doctor",
     "eval_traj",
     "odometry",
     "read_cloud",
@@ -150,3 +151,11 @@ def calibrate_planes(ref, target, *, init=None, config=None, out=None, report=No
     T_ref_target_matrix (4x4) and covariance_matrix (6x6); `out` writes the pair's extrinsics YAML."""
     options = _native_options(dict(init=init, config=config, out=out, report=report))
     return _mlidar.calibrate_planes(os.fspath(ref), os.fspath(target), **options)
+
+
+def doctor(input, *, topics: str = None, base: str = None, stamp_at: str = None, extrinsics=None,
+           models: str = None) -> dict[str, Any]:
+    """`mlidar doctor`: a dataset folder or bag checked before a long run, as `doctor --json`'s dict
+    {input, failed, findings: [{check, lidar, severity, message}]}; `failed` is the CLI's exit 1."""
+    options = _native_options(dict(topics=topics, base=base, stamp_at=stamp_at, extrinsics=extrinsics, models=models))
+    return _mlidar.doctor(os.fspath(input), **options)

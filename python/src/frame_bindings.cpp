@@ -1,4 +1,5 @@
-// FrameSource: a dataset folder, a folder of one LiDAR's clouds or a bag, frame by frame (io/frame_source.hpp).
+// FrameSource: a dataset folder, a folder of one LiDAR's clouds or a bag, frame by frame (io/frame_source.hpp);
+// doctor: `mlidar doctor` on one of them.
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "bindings.hpp"
 #include "mlidar/io/bag_frames.hpp"
 #include "mlidar/io/frame_source.hpp"
+#include "mlidar/pipelines/dataset_doctor.hpp"
 #include "mlidar/sim/lidar_models.hpp"
 
 namespace mlidar::python {
@@ -107,6 +109,22 @@ void add_frames(py::module_& module) {
       .def_property_readonly("stamps", [](const io::FrameSource& source) { return py::array(py::cast(source.stamps())); })
       .def_property_readonly("period", &io::FrameSource::period)
       .def_property_readonly("notes", &io::FrameSource::notes);
+  module.def(
+      "doctor",
+      [](const std::filesystem::path& input, const std::string& topics, const std::string& base, const std::string& stamp_at,
+         const std::string& extrinsics, const std::string& models) {
+        std::string json;
+        {
+          py::gil_scoped_release release;
+          const io::BagArguments bag{"", topics, base, stamp_at, extrinsics, models, 0.0, 0.0};
+          json = pipelines::doctor_json(input.string(), pipelines::examine_input(input, bag)).dump();
+        }
+        return py::module_::import("json").attr("loads")(json);
+      },
+      py::arg("input"), py::kw_only(), py::arg("topics") = "", py::arg("base") = "", py::arg("stamp_at") = "auto",
+      py::arg("extrinsics") = "", py::arg("models") = "",
+      "`mlidar doctor`: a dataset folder or bag checked before a long run, as `doctor --json`'s dict {input, failed, "
+      "findings: [{check, lidar, severity, message}]}; failed is the CLI's exit 1.");
 }
 
 }  // namespace mlidar::python

@@ -326,4 +326,22 @@ bool has_failure(const std::vector<Finding>& findings) {
   return std::any_of(findings.begin(), findings.end(), [](const Finding& f) { return f.severity == Severity::kFailure; });
 }
 
+std::vector<Finding> examine_input(const std::filesystem::path& input, io::BagArguments bag, const DoctorConfig& config) {
+  const bool folder = std::filesystem::is_directory(input);
+  bag.bag = folder ? std::string{} : input.string();
+  try {
+    const io::FrameSource source = open_frames(folder ? input : std::filesystem::path{}, bag.bag, io::bag_source_options(bag));
+    return examine(source, config);
+  } catch (const InputError& error) {  // what every job would stop at before its first frame
+    return {{"open", "", Severity::kFailure, error.what()}};
+  }
+}
+
+nlohmann::json doctor_json(const std::string& input, const std::vector<Finding>& findings) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& f : findings)
+    list.push_back({{"check", f.check}, {"lidar", f.lidar}, {"severity", to_string(f.severity)}, {"message", f.message}});
+  return {{"input", input}, {"failed", has_failure(findings)}, {"findings", list}};
+}
+
 }  // namespace mlidar::pipelines

@@ -12,6 +12,9 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "mlidar/io/bag_frames.hpp"
 #include "mlidar/io/frame_source.hpp"
 #include "mlidar/pipelines/doctor_motion.hpp"
 
@@ -45,5 +48,12 @@ std::vector<Finding> examine(const io::FrameSource& source, const DoctorConfig& 
 
 /// True when some finding is a failure (the command's exit 1).
 bool has_failure(const std::vector<Finding>& findings);
+
+/// `mlidar doctor INPUT`: a dataset folder or a bag (with `bag`'s topics and files) opened and examined; an input
+/// that cannot be opened is one failure finding ("open"), as every job would stop there.
+std::vector<Finding> examine_input(const std::filesystem::path& input, io::BagArguments bag, const DoctorConfig& config = {});
+
+/// `doctor --json`'s document: {input, failed, findings: [{check, lidar, severity, message}]}.
+nlohmann::json doctor_json(const std::string& input, const std::vector<Finding>& findings);
 
 }  // namespace mlidar::pipelines
