@@ -12,7 +12,7 @@ packages=(
   python3-yaml python3-rosbag python3-sensor-msgs python3-tf2-msgs python3-roslz4 python3-zstandard python3-lz4
   libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev
   chromium fonts-liberation
-  python3-dev pybind11-dev python3-numpy python3-pytest
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-dask python3-distributed
 )
 
 missing=()

@@ -53,6 +53,9 @@ const std::vector<Examples>& examples() {
        {"mlidar eval detections --gt det_test --pred detector_out --json ap.json --plot pr.svg",
         "mlidar eval detections --gt det_test/groundtruth --pred detector_out/label_2 --classes car --iou car=0.5"}},
       {{"doctor"}, {"mlidar doctor sim", "mlidar doctor drive.bag --topics /top/points:top,/front/points:front --json doctor.json"}},
+      {{"fleet", "run"},
+       {"mlidar fleet run --jobs jobs.yaml --out fleet --local 2",
+        "mlidar fleet run --jobs /shared/fleet/jobs.yaml --out /shared/fleet/week49 --scheduler tcp://scheduler-host:8786"}},
       {{"report"}, {"mlidar report run", "mlidar report run --dataset sim --out run_with_truth.html"}},
   };
   return all;

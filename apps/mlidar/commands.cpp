@@ -16,7 +16,8 @@ std::vector<Command> register_commands(CLI::App& app, const CliContext& context)
           register_perturb(app, context),
           register_eval(app, context),
           register_report(app),
-          register_doctor(app)};
+          register_doctor(app),
+          register_fleet(app)};
 }
 
 CLI::Validator thread_count() {

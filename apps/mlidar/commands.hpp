@@ -42,6 +42,8 @@ Command register_bag(CLI::App& app, const CliContext& context);
 Command register_report(CLI::App& app);
 Command register_doctor(CLI::App& app);
 Command register_perturb(CLI::App& app, const CliContext& context);
+/// `fleet run`: the Python package's Dask fleet (command_fleet.cpp).
+Command register_fleet(CLI::App& app);
 
 /// All sub-commands, in the order `mlidar --help` lists them. `context` must outlive the returned commands.
 std::vector<Command> register_commands(CLI::App& app, const CliContext& context);

@@ -28,3 +28,13 @@ def test_the_installed_package_imports_and_reads_a_cloud_from_the_prefix(tmp_pat
                             capture_output=True, text=True, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "[0.0, 1.0, 2.0, 3.0]"
+
+    # The installed executable's `fleet run` starts Python on the installed package (not the build tree's): a jobs
+    # file naming a missing recording is the package's exit 3, naming the field.
+    jobs = tmp_path / "jobs.yaml"
+    jobs.write_text("jobs:\n  - {vehicle: v, recording: nowhere, task: doctor}\n")
+    fleet = subprocess.run([str(prefix / "bin" / "mlidar"), "fleet", "run", "--jobs", str(jobs), "--out", str(tmp_path / "f")],
+                           env=environment, capture_output=True, text=True, cwd=tmp_path)
+    assert fleet.returncode == 3, fleet.stderr
+    assert "jobs[0].recording" in fleet.stderr
+    assert (prefix / os.environ["MLIDAR_PYTHON_INSTALL_DIR"] / "mlidar" / "fleet.py").exists()
