@@ -47,3 +47,18 @@ def test_a_lidar_the_dataset_lacks_and_a_missing_folder_are_refused(drive, tmp_p
     with pytest.raises(mlidar.InputError) as raised:
         mlidar.FrameSource.dataset(tmp_path / "nothing")
     assert "nothing" in raised.value.file
+
+
+def test_doctor_gives_the_clis_findings(drive, tmp_path):
+    import json
+
+    from conftest import run_cli
+
+    findings = mlidar.doctor(drive)
+    run_cli("doctor", drive, "--json", tmp_path / "doctor.json")
+    assert findings == json.loads((tmp_path / "doctor.json").read_text())
+    assert findings["failed"] is False and {f["check"] for f in findings["findings"]} >= {"stamps", "extrinsics"}
+    broken = mlidar.doctor(tmp_path / "nowhere.bag", topics="/top/points:top")
+    assert broken["failed"] is True and broken["findings"][0]["check"] == "open" and "nowhere.bag" in broken["findings"][0]["message"]
+    with pytest.raises(mlidar.UsageError):  # the CLI's exit 2: a bag needs its topics
+        mlidar.doctor(tmp_path / "nowhere.bag")
