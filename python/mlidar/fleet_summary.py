@@ -138,6 +138,9 @@ def _terminal_lines(summary: dict) -> list[str]:
     for job in summary["jobs"]:
         if job["status"] != "done":
             lines.append(f"failed  {job['id']}: {job['error']['message']}")
+        elif job["verdict"] == "untrusted":
+            page = "doctor.json" if job["task"] == "doctor" else "report.html"
+            lines.append(f"not trusted  {job['id']}: exit {job['exit_code']}, {job['out']}/{page} says why")
     for m in summary["moved"]:
         lines.append(f"MOVED   {m['vehicle']} {m['lidar']}: between {m['from']} and {m['to']} by {m['rotation_deg']:.2f} deg, "
                      f"{m['translation_m'] * 100:.1f} cm (d2 {m['d2']:.0f})" if m["d2"] is not None else

@@ -173,3 +173,16 @@ def test_a_bad_input_is_reported_and_not_retried(week, tmp_path):
     assert evaluation["status"] == "failed" and "van1-broken-slam" in evaluation["error"]["message"]
     assert summary["exit_code"] == 1 and summary["recordings"][0]["verdict"] == "failed"
     assert not (tmp_path / "fleet" / "jobs" / "van1-broken-slam").exists()
+
+
+def test_an_eval_job_evaluates_the_slam_job_it_names(week, tmp_path):
+    jobs = tmp_path / "jobs.yaml"
+    jobs.write_text(f"jobs:\n  - {{vehicle: van1, recording: {week}/van1/day0, task: slam, id: mon, options: {{calibrate: fixed}}}}\n"
+                    f"  - {{vehicle: van1, recording: {week}/van1/day0, task: eval, options: {{of: mon}}}}\n")
+    summary = run_fleet(jobs, tmp_path / "fleet", local=1, report=lambda line: None)
+    slam, evaluation = summary["jobs"]
+    assert slam["status"] == evaluation["status"] == "done" and slam["exit_code"] == 0
+    report = json.loads((tmp_path / "fleet" / "jobs" / evaluation["id"] / "eval.json").read_text())
+    assert evaluation["ate_rmse_m"] == report["ate"]["translation_m"]["rmse"] < 0.05
+    assert "pose_nees" in report  # the slam job's pose covariances were given to the evaluation
+    assert summary["drift"] == {}  # given extrinsics (--calibrate fixed) are no estimates
