@@ -186,3 +186,32 @@ def test_an_eval_job_evaluates_the_slam_job_it_names(week, tmp_path):
     assert evaluation["ate_rmse_m"] == report["ate"]["translation_m"]["rmse"] < 0.05
     assert "pose_nees" in report  # the slam job's pose covariances were given to the evaluation
     assert summary["drift"] == {}  # given extrinsics (--calibrate fixed) are no estimates
+
+
+def test_ctrl_c_stops_the_fleet_and_the_same_command_resumes_it(week, tmp_path):
+    import subprocess
+
+    from conftest import mlidar_bin
+
+    out = tmp_path / "fleet"
+    command = [mlidar_bin(), "fleet", "run", "--jobs", str(week / "jobs.yaml"), "--out", str(out), "--local", "1"]
+    # SIGINT as a terminal sends it (a test runner may have started us with SIGINT ignored, which children inherit).
+    fleet = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.time() + 120
+    while time.time() < deadline and not any((out / "jobs").glob("*/fleet_job.json")):
+        time.sleep(0.05)  # until one job is complete
+    fleet.send_signal(signal.SIGINT)
+    _, stderr = fleet.communicate(timeout=120)
+    assert fleet.returncode == 130, stderr
+    assert "interrupted" in stderr and "run the same command again to resume" in stderr
+    assert not (out / "fleet.json").exists()
+    done_before = {p.parent.name for p in (out / "jobs").glob("*/fleet_job.json")}
+    assert 1 <= len(done_before) < 6
+
+    resumed = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert resumed.returncode == 1 and "MOVED   van2 right: between day1 and day2" in resumed.stdout  # the moved LiDAR
+    fleet_json = json.loads((out / "fleet.json").read_text())
+    assert {job["id"] for job in fleet_json["jobs"] if job["reused"]} >= done_before
+    assert all(job["status"] == "done" and job["runs"] == 1 for job in fleet_json["jobs"])
+    assert not [p.name for p in (out / "jobs").iterdir() if "stage" in p.name]
