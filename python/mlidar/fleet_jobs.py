@@ -31,7 +31,7 @@ import yaml
 from mlidar import _mlidar
 
 TASKS = ("calibrate-auto", "slam", "eval", "doctor")
-_NAME = re.compile(r"^[A-Za-z0-9._-]+$")
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")  # starts with a letter or digit: never '.', '..' or hidden
 _JOB_KEYS = {"id", "vehicle", "recording", "date", "task", "options"}
 # Options that the fleet sets itself for every job.
 _FLEET_OWNED = {"out", "dataset", "bag", "input", "progress", "overwrite", "arguments", "gt", "est"}
@@ -97,7 +97,7 @@ def _text(path: Path, field: str, value: Any) -> str:
 def _name(path: Path, field: str, value: Any) -> str:
     text = _text(path, field, value)
     if not _NAME.match(text):
-        raise _error(path, field, f"'{text}' is not a name (use letters, digits, '.', '_' and '-')")
+        raise _error(path, field, f"'{text}' is not a name (letters, digits, '.', '_' and '-', starting with a letter or digit)")
     return text
 
 
@@ -131,8 +131,13 @@ def _parse_job(path: Path, index: int, entry: Any, defaults: dict) -> Job:
         merged[key] = str((path.parent / _text(path, f"{where}.options.{key}", merged[key])).resolve())
     if task == "eval" and ("of" in merged) == ("estimate" in merged):
         raise _error(path, f"{where}.options", "eval needs exactly one of 'of' (a slam job's id) and 'estimate' (a TUM file)")
-    job_id = entry.get("id", f"{vehicle}-{recording.name}-{task}")
-    return Job(_name(path, f"{where}.id", job_id), vehicle, recording, task, str(entry.get("date", "")), index, merged)
+    if "id" in entry:
+        job_id = _name(path, f"{where}.id", entry["id"])
+    elif not _NAME.match(default_id := f"{vehicle}-{recording.name}-{task}"):
+        raise _error(path, f"{where}.id", f"missing, and '{default_id}' (vehicle-recording-task) is not a name: give the job an id")
+    else:
+        job_id = default_id
+    return Job(job_id, vehicle, recording, task, str(entry.get("date", "")), index, merged)
 
 
 def _check_defaults(path: Path, defaults: Any) -> dict:

@@ -11,6 +11,7 @@ from mlidar.fleet_jobs import read_jobs
 def write(folder, text):
     (folder / "rec1").mkdir(exist_ok=True)
     (folder / "rec2").mkdir(exist_ok=True)
+    (folder / "rec 3").mkdir(exist_ok=True)
     path = folder / "jobs.yaml"
     path.write_text(textwrap.dedent(text))
     return path
@@ -41,6 +42,8 @@ def test_jobs_take_defaults_ids_and_paths_from_the_files_folder(tmp_path):
     ("jobs:\n  - {vehicle: v, recording: rec1, task: slam, options: {stage: all}}\n", "jobs[0].options.stage",
      "not an option of slam"),
     ("jobs:\n  - {vehicle: 'v 1', recording: rec1, task: slam}\n", "jobs[0].vehicle", "not a name"),
+    ("jobs:\n  - {vehicle: v, recording: rec1, task: slam, id: ..}\n", "jobs[0].id", "not a name"),
+    ("jobs:\n  - {vehicle: v, recording: 'rec 3', task: slam}\n", "jobs[0].id", "give the job an id"),
     ("jobs:\n  - {vehicle: v, recording: rec1, task: slam}\n  - {vehicle: v, recording: rec1, task: slam}\n", "jobs[1].id",
      "also the id of jobs[0]"),
     ("jobs:\n  - {vehicle: v, recording: rec1, task: eval}\n", "jobs[0].options", "exactly one of 'of'"),
