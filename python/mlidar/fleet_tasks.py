@@ -113,10 +113,17 @@ def _run_doctor(job: Job, out: Path) -> int:
     for name in ("doctor.json", "run.json"):
         with open(stage / name, "rb") as handle:
             os.fsync(handle.fileno())
-    if out.exists():
-        shutil.rmtree(out)
-    os.rename(stage, out)
+    _publish(stage, out)
     return 1 if findings["failed"] else 0
+
+
+def _publish(stage: Path, out: Path) -> None:
+    """`stage` takes the place of `out`; an earlier `out` is moved aside first and removed last (the CLI's rule)."""
+    previous = out.parent / f".{out.name}.fleet-stage-old-{os.getpid()}"
+    if out.exists():
+        os.rename(out, previous)
+    os.rename(stage, out)
+    shutil.rmtree(previous, ignore_errors=True)
 
 
 def _execute(job: Job, out: Path, fleet_out: Path) -> int:
