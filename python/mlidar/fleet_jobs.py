@@ -63,6 +63,8 @@ def _construct_unique_mapping(loader, node, deep=False):
     seen = set()
     for key_node, _ in node.value:
         key = loader.construct_object(key_node, deep=deep)
+        if not isinstance(key, (str, int, float, bool)) and key is not None:
+            raise yaml.constructor.ConstructorError(None, None, "a key must be a text", key_node.start_mark)
         if key in seen:
             raise yaml.constructor.ConstructorError(None, None, f"key '{key}' given twice", key_node.start_mark)
         seen.add(key)
@@ -70,6 +72,10 @@ def _construct_unique_mapping(loader, node, deep=False):
 
 
 _UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_unique_mapping)
+# Dates stay text (`date` only orders recordings): no timestamp parsing, so no calendar errors.
+_UniqueKeyLoader.yaml_implicit_resolvers = {
+    first: [(tag, pattern) for tag, pattern in resolvers if tag != "tag:yaml.org,2002:timestamp"]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()}
 
 
 def _error(path: Path, field: str, problem: str) -> _mlidar.InputError:
@@ -172,13 +178,15 @@ def read_jobs(path: str | Path) -> list[Job]:
         document = yaml.load(path.read_text(), Loader=_UniqueKeyLoader)
     except OSError as error:
         raise _error(path, "file", f"cannot be read ({error.strerror})") from None
-    except yaml.YAMLError as error:
+    except UnicodeDecodeError as error:
+        raise _error(path, "file", f"not UTF-8 text (byte {error.start}): save it as UTF-8") from None
+    except (yaml.YAMLError, ValueError, TypeError, RecursionError) as error:
         raise _error(path, "yaml", f"not valid YAML ({error})") from None
     if not isinstance(document, dict) or "jobs" not in document:
         raise _error(path, "jobs", "missing (the file holds `jobs:`, a list of {vehicle, recording, task})")
     for key in document:
         if key not in ("jobs", "defaults"):
-            raise _error(path, key, "unknown key (known: defaults, jobs)")
+            raise _error(path, str(key), "unknown key (known: defaults, jobs)")
     if not isinstance(document["jobs"], list) or not document["jobs"]:
         raise _error(path, "jobs", "expected a non-empty list of jobs")
     defaults = _check_defaults(path, document.get("defaults", {}))

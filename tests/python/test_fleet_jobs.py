@@ -59,3 +59,42 @@ def test_a_bad_jobs_file_is_an_input_error_naming_the_field(tmp_path, text, fiel
         read_jobs(path)
     assert error.value.file == str(path) and error.value.field == field
     assert words in str(error.value) and str(path) in str(error.value)
+
+
+def test_mutated_jobs_files_give_jobs_or_an_input_error_and_nothing_else(tmp_path):
+    # The jobs file's fuzz test: bytes flipped, cut, repeated and spliced in a valid file (fixed seed).
+    import random
+
+    valid = write(tmp_path, """\
+        defaults: {threads: 2}
+        jobs:
+          - {vehicle: van1, recording: rec1, task: calibrate-auto, date: 2026-12-01, options: {stage: all}}
+          - {vehicle: van1, recording: rec2, task: slam, id: van1-tue, options: {calibrate: fixed}}
+          - {vehicle: van1, recording: rec2, task: eval, options: {of: van1-tue, align: se3}}
+        """).read_bytes()
+    rng = random.Random(1)
+    alphabet = b"{}[]:,-'\"\n #&*!|>%@`\t\x00\xff" + bytes(range(48, 123))
+    path = tmp_path / "mutated.yaml"
+    outcomes = {"jobs": 0, "error": 0}
+    for _ in range(1500):
+        data = bytearray(valid)
+        for _ in range(rng.randint(1, 6)):
+            k = rng.randrange(len(data) + 1)
+            choice = rng.random()
+            if choice < 0.4 and data:
+                data[min(k, len(data) - 1)] = rng.choice(alphabet)
+            elif choice < 0.6:
+                del data[k:k + rng.randint(1, 20)]
+            elif choice < 0.8:
+                data[k:k] = bytes(rng.choice(alphabet) for _ in range(rng.randint(1, 5)))
+            else:
+                start = rng.randrange(len(valid))
+                data[k:k] = valid[start:start + rng.randint(1, 40)]
+        path.write_bytes(bytes(data))
+        try:
+            read_jobs(path)
+            outcomes["jobs"] += 1
+        except mlidar.InputError as error:
+            assert error.file == str(path) and error.field
+            outcomes["error"] += 1
+    assert outcomes["jobs"] > 0 and outcomes["error"] > 0
