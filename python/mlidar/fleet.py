@@ -15,18 +15,19 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import json
 import logging
 import os
 import signal
 import sys
 import time
-from datetime import datetime, timezone
 from pathlib import Path
 from typing import Optional
 
 import mlidar
 from mlidar import _mlidar
+from mlidar.fleet_files import utc_now, write_text_atomically
 from mlidar.fleet_jobs import Job, read_jobs, task_options
 from mlidar.fleet_summary import summarize, write_summary
 from mlidar.fleet_tasks import run_job
@@ -37,10 +38,6 @@ _RETRIES = 2  # a job whose worker broke runs again on another worker, this many
 
 class FleetUsageError(Exception):
     """A command line or --out that cannot be acted on (exit 2)."""
-
-
-def _utc_now() -> str:
-    return datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 def _is_within(inner: Path, outer: Path) -> bool:
@@ -63,18 +60,9 @@ def prepare_out(out: Path, jobs: list[Job], jobs_file: Path, arguments: list[str
     (out / "jobs").mkdir(parents=True, exist_ok=True)
     previous = json.loads((out / _MARKER).read_text()) if (out / _MARKER).exists() else {}
     run = {"tool": "mlidar", "version": mlidar.__version__, "command": "fleet run", "arguments": arguments,
-           "jobs_file": str(jobs_file), "started_utc": _utc_now(), "runs": previous.get("runs", 0) + 1}
-    _write_json(out / _MARKER, run)
+           "jobs_file": str(jobs_file), "started_utc": utc_now(), "runs": previous.get("runs", 0) + 1}
+    write_text_atomically(out / _MARKER, json.dumps(run, indent=2) + "\n")
     return run
-
-
-def _write_json(path: Path, document: dict) -> None:
-    stage = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    with open(stage, "w") as handle:
-        handle.write(json.dumps(document, indent=2) + "\n")
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.rename(stage, path)
 
 
 @contextlib.contextmanager
@@ -109,7 +97,7 @@ def _check_workers_see(client, out: Path) -> None:
 def _with_thread_default(job: Job) -> Job:
     """One thread per job unless the job says otherwise: the workers are the parallelism."""
     if "threads" in task_options(job.task) and "threads" not in job.options:
-        return Job(job.id, job.vehicle, job.recording, job.task, job.date, job.order, {**job.options, "threads": 1})
+        return dataclasses.replace(job, options={**job.options, "threads": 1})
     return job
 
 

@@ -8,8 +8,6 @@ calibrated) are not estimates and are left out. drift.py compares a LiDAR's cons
 from __future__ import annotations
 
 import json
-import os
-from datetime import datetime, timezone
 from pathlib import Path
 from typing import Optional
 
@@ -17,14 +15,16 @@ import numpy as np
 
 import mlidar
 from mlidar import drift
+from mlidar.fleet_files import utc_now, write_text_atomically
 from mlidar.fleet_jobs import Job
+from mlidar.fleet_tasks import job_log_path
 
 
 def _log_counts(out: Path, job: Job) -> dict:
     """Starts and completed runs of a job in this fleet folder, over every fleet run (its .log)."""
     counts = {"starts": 0, "runs": 0, "reuses": 0}
     try:
-        lines = (out / "jobs" / f".{job.id}.log").read_text().splitlines()
+        lines = job_log_path(out, job).read_text().splitlines()
     except OSError:
         return counts
     for line in lines:
@@ -122,7 +122,7 @@ def summarize(jobs: list[Job], records: dict, out: Path, run: dict, *, seconds: 
     untrusted = [e["id"] for e in entries if e["verdict"] == "untrusted"]
     summary = {"tool": "mlidar", "version": mlidar.__version__, "command": "fleet run", "arguments": run["arguments"],
                "jobs_file": run["jobs_file"], "started_utc": run["started_utc"],
-               "finished_utc": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"), "seconds": seconds,
+               "finished_utc": utc_now(), "seconds": seconds,
                "workers": workers, "drift_rule": {"rotation_deg": rule.rotation_deg, "translation_m": rule.translation_m,
                                                   "confidence": rule.confidence},
                "jobs": entries, "recordings": list(recordings.values()), "drift": drift_by_vehicle, "moved": moved,
@@ -155,8 +155,8 @@ def write_summary(out: Path, summary: dict) -> None:
     from mlidar.fleet_html import fleet_html
 
     document = {key: value for key, value in summary.items() if key != "terminal"}
-    _write_atomically(out / "fleet.json", json.dumps(document, indent=2, default=_json_default) + "\n")
-    _write_atomically(out / "fleet.html", fleet_html(document))
+    write_text_atomically(out / "fleet.json", json.dumps(document, indent=2, default=_json_default) + "\n")
+    write_text_atomically(out / "fleet.html", fleet_html(document))
 
 
 def _json_default(value):
@@ -164,11 +164,3 @@ def _json_default(value):
         return value.item()
     raise TypeError(f"{type(value).__name__} is not JSON")
 
-
-def _write_atomically(path: Path, text: str) -> None:
-    stage = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    with open(stage, "w") as handle:
-        handle.write(text)
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.rename(stage, path)

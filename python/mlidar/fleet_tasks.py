@@ -24,6 +24,7 @@ from typing import Any, Optional
 
 import mlidar
 from mlidar import _mlidar
+from mlidar.fleet_files import write_text_atomically
 from mlidar.fleet_jobs import Job
 
 # Errors that say the job's input or options are wrong: the same on every worker, so never retried.
@@ -58,9 +59,14 @@ def job_lock(fleet_out: Path, job: Job):
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
+def job_log_path(fleet_out: Path, job: Job) -> Path:
+    """The job's JSON-lines log: one line per start, finish, reuse or failure, over every fleet run."""
+    return fleet_out / "jobs" / f".{job.id}.log"
+
+
 def _log(fleet_out: Path, job: Job, event: str, **fields) -> None:
     entry = {"event": event, "host": socket.gethostname(), "pid": os.getpid(), "time": time.time(), **fields}
-    with open(fleet_out / "jobs" / f".{job.id}.log", "a") as log:
+    with open(job_log_path(fleet_out, job), "a") as log:
         log.write(json.dumps(entry) + "\n")
         log.flush()
         os.fsync(log.fileno())
@@ -126,15 +132,15 @@ def _publish(stage: Path, out: Path) -> None:
     shutil.rmtree(previous, ignore_errors=True)
 
 
-def _execute(job: Job, out: Path, fleet_out: Path) -> int:
-    """Runs the job into `out`; its exit code (0 trusted, 1 ran but not to be trusted)."""
+def _execute(job: Job, out: Path, inputs: dict) -> int:
+    """Runs the job into `out` (an eval on its `_eval_inputs`); its exit code (0 trusted, 1 ran but not to be
+    trusted)."""
     common = {"out": out, "overwrite": True, **job.options}
     if job.task == "doctor":
         return _run_doctor(job, out)
     if job.task == "eval":
-        inputs = _eval_inputs(job, fleet_out)
-        gt, est = inputs.pop("gt"), inputs.pop("est")
-        mlidar.eval_traj(gt, est, out=out, overwrite=True, **inputs)
+        options = {key: value for key, value in inputs.items() if key not in ("gt", "est")}
+        mlidar.eval_traj(inputs["gt"], inputs["est"], out=out, overwrite=True, **options)
         return 0
     function = mlidar.calibrate_auto if job.task == "calibrate-auto" else mlidar.slam
     return function(**_recording_keyword(job), **common).exit_code
@@ -153,12 +159,7 @@ def _completed_exit_code(out: Path, job: Job, fingerprint: dict) -> Optional[int
 
 def _mark_complete(out: Path, job: Job, fingerprint: dict, exit_code: int) -> None:
     record = {"id": job.id, "vehicle": job.vehicle, "date": job.date, "exit_code": exit_code, "job": fingerprint}
-    stage = out / f".{_MARKER}.tmp"
-    with open(stage, "w") as handle:
-        handle.write(json.dumps(record, indent=2) + "\n")
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.rename(stage, out / _MARKER)
+    write_text_atomically(out / _MARKER, json.dumps(record, indent=2) + "\n")
 
 
 def _worker_address() -> str:
@@ -196,7 +197,7 @@ def run_job(job: Job, fleet_out: str, dependency: Optional[dict] = None) -> dict
         _remove_leftovers(fleet_out, job)
         _log(fleet_out, job, "started")
         try:
-            exit_code = _execute(job, out, fleet_out)
+            exit_code = _execute(job, out, inputs)
         except _DETERMINISTIC as error:
             _log(fleet_out, job, "failed", error=str(error))
             return _record(job, "failed", fleet_out, started, exit_code=3 if isinstance(error, _mlidar.InputError) else 2,

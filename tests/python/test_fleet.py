@@ -140,12 +140,12 @@ def test_a_job_whose_worker_breaks_runs_again_on_another_worker(week, tmp_path, 
     failed_on = []
     execute = tasks._execute
 
-    def breaks_on_the_first_worker(job, out, fleet_out):
+    def breaks_on_the_first_worker(job, out, inputs):
         worker = distributed.get_worker().address
         if not failed_on or failed_on[0] == worker:
             failed_on.append(worker)
             raise OSError(28, "No space left on device")
-        return execute(job, out, fleet_out)
+        return execute(job, out, inputs)
 
     monkeypatch.setattr(tasks, "_execute", breaks_on_the_first_worker)  # the workers are threads of this process
     jobs = tmp_path / "jobs.yaml"
