@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "mlidar/detect/box_coding.hpp"
 #include "mlidar/eval/box_iou.hpp"
 
 namespace mlidar::detect {
@@ -14,8 +15,6 @@ double wrap_half_turn(double angle) {
   const double wrapped = std::fmod(angle + std::numbers::pi / 2, std::numbers::pi);
   return (wrapped < 0.0 ? wrapped + std::numbers::pi : wrapped) - std::numbers::pi / 2;
 }
-
-double centre_z(const io::Box3D& box) { return box.center_bottom.z() + 0.5 * box.height; }
 
 int head_cells(double from, double to, const BevGridConfig& grid, int stride) {
   return static_cast<int>(std::ceil((to - from) / (grid.cell * stride) - 1e-9));
@@ -35,7 +34,7 @@ AnchorResidual encode_anchor(const io::Box3D& box, const io::Box3D& anchor) {
   const double diagonal = std::hypot(anchor.length, anchor.width);
   return {(box.center_bottom.x() - anchor.center_bottom.x()) / diagonal,
           (box.center_bottom.y() - anchor.center_bottom.y()) / diagonal,
-          (centre_z(box) - centre_z(anchor)) / anchor.height,
+          (box_centre(box).z() - box_centre(anchor).z()) / anchor.height,
           std::log(box.length / anchor.length),
           std::log(box.width / anchor.width),
           std::log(box.height / anchor.height),
@@ -49,7 +48,7 @@ io::Box3D decode_anchor(const AnchorResidual& r, const io::Box3D& anchor) {
   box.width = anchor.width * std::exp(r[4]);
   box.height = anchor.height * std::exp(r[5]);
   box.yaw = anchor.yaw + r[6];
-  const double z = centre_z(anchor) + r[2] * anchor.height;
+  const double z = box_centre(anchor).z() + r[2] * anchor.height;
   box.center_bottom = Vec3(anchor.center_bottom.x() + r[0] * diagonal, anchor.center_bottom.y() + r[1] * diagonal, z - 0.5 * box.height);
   return box;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "mlidar/detect/box_coding.hpp"
 #include "mlidar/eval/box_iou.hpp"
 
 namespace mlidar::detect {
@@ -45,7 +46,7 @@ std::vector<std::size_t> non_maximum_suppression(std::span<const io::LabelledBox
 }
 
 io::Box3D to_base(const io::Box3D& box, const SE3& T_base_lidar) {
-  const Vec3 centre = T_base_lidar * Vec3(box.center_bottom + Vec3(0.0, 0.0, 0.5 * box.height));
+  const Vec3 centre = T_base_lidar * box_centre(box);
   const Vec3 heading = T_base_lidar.rotation() * Vec3(std::cos(box.yaw), std::sin(box.yaw), 0.0);
   io::Box3D out = box;
   out.yaw = std::atan2(heading.y(), heading.x());
