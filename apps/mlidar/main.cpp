@@ -1,7 +1,6 @@
 // mlidar command-line entry point: parses the command line and maps errors to
 // the documented exit codes (0 ok, 1 untrusted/failed, 2 usage, 3 bad input,
 // 130/143 interrupted by SIGINT/SIGTERM).
-#include <malloc.h>
 #include <pthread.h>
 #include <signal.h>
 #include <unistd.h>
@@ -16,6 +15,7 @@
 
 #include "apps/mlidar/commands.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/core/heap_settings.hpp"
 #include "mlidar/core/version.hpp"
 #include "mlidar/io/interrupt_cleanup.hpp"
 
@@ -41,18 +41,9 @@ void handle_interrupts() {
 
 }  // namespace
 
-/// Large buffers (a decoded scan, a decompressed chunk: 0.2-1 MB, each frame) stay in the heap instead of being
-/// mapped and unmapped every time: the page faults and zeroing of fresh pages took 60 % of `bag export` (900 MB
-/// bag: 4.1 s -> 1.6 s); slam's time per frame is unchanged.
-void keep_large_buffers_in_the_heap() {
-  constexpr int kBytes = 256 << 20;
-  mallopt(M_MMAP_THRESHOLD, kBytes);
-  mallopt(M_TRIM_THRESHOLD, kBytes);
-}
-
 int main(int argc, char** argv) {
   using mlidar::ExitCode;
-  keep_large_buffers_in_the_heap();
+  mlidar::keep_large_buffers_in_the_heap();  // core/heap_settings.hpp
   handle_interrupts();
   CLI::App app{"mlidar: calibration, odometry, mapping and detection for robots with several LiDARs"};
   app.footer(

@@ -11,7 +11,6 @@ removes what a killed earlier start left behind (its staging folders), and appen
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import fcntl
 import hashlib
 import json
@@ -32,16 +31,6 @@ _DETERMINISTIC = (_mlidar.InputError, _mlidar.UsageError)
 # Written into a job's run folder once it is complete: the job as run and its exit code.
 _MARKER = "fleet_job.json"
 _RESULT_FILES = {"calibrate-auto": "calibration.json", "slam": "metrics.json", "eval": "eval.json", "doctor": "doctor.json"}
-
-
-def keep_large_buffers_in_the_heap() -> None:
-    """What the CLI's main() does (apps/mlidar/main.cpp): a decoded scan or chunk (0.2-1 MB a frame) stays in the heap
-    instead of being mapped and unmapped each time. Dask's nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536,
-    the opposite; mallopt overrides it for this worker process."""
-    libc = ctypes.CDLL(None)
-    m_trim_threshold, m_mmap_threshold, bytes_ = -1, -3, 256 << 20
-    libc.mallopt(m_mmap_threshold, bytes_)
-    libc.mallopt(m_trim_threshold, bytes_)
 
 
 def job_folder(fleet_out: Path, job: Job) -> Path:
@@ -182,7 +171,9 @@ def run_job(job: Job, fleet_out: str, dependency: Optional[dict] = None) -> dict
     failure, so that the fleet can tell a bad input (not retried) from a broken worker (retried elsewhere)."""
     fleet_out = Path(fleet_out)
     started = time.time()
-    keep_large_buffers_in_the_heap()
+    # The CLI's heap settings (core/heap_settings.hpp): Dask's nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536,
+    # the opposite; mallopt overrides it for this worker process.
+    _mlidar.keep_large_buffers_in_the_heap()
     if dependency is not None and dependency["status"] != "done":
         return _record(job, "failed", fleet_out, started, exit_code=None,
                        error={"message": f"not run: job {dependency['id']} that it evaluates failed", "file": "", "field": ""})

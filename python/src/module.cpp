@@ -4,6 +4,7 @@
 
 #include "bindings.hpp"
 #include "mlidar/core/error.hpp"
+#include "mlidar/core/heap_settings.hpp"
 #include "mlidar/core/version.hpp"
 
 namespace mlidar::python {
@@ -61,4 +62,6 @@ PYBIND11_MODULE(_mlidar, module) {
   mlidar::python::add_jobs(module);
   mlidar::python::add_eval(module);
   mlidar::python::add_calibration(module);
+  module.def("keep_large_buffers_in_the_heap", &mlidar::keep_large_buffers_in_the_heap,
+             "What the CLI's main does (core/heap_settings.hpp): large buffers stay in the heap; a job's worker calls it");
 }
