@@ -36,6 +36,7 @@ struct DetectionOptions {
   int frames = 100;
   std::uint64_t seed = 1;
   std::string split = "train";
+  std::string scene = "street";
   std::string encoding = "binary";
   bool overwrite = false;
   std::string out;
@@ -116,6 +117,7 @@ int run_detection(const DetectionOptions& options, const CliContext& context) {
   spec.frames = options.frames;
   spec.seed = options.seed;
   spec.split = sim::detection_split_from_name(options.split);
+  spec.layout = sim::detection_layout_from_name(options.scene);
   spec.encoding = io::pcd_encoding_from_name(options.encoding);
   io::RunFolder run(options.out, "simulate detection", context.run_folder(options.overwrite, {}));
   sim::write_detection_dataset(spec, run.path(), terminal_progress_bar());
@@ -132,6 +134,10 @@ void add_detection(CLI::App& simulate, DetectionOptions& options) {
   cmd->add_option("--seed", options.seed, "Random seed (same seed and split, same bytes)")->capture_default_str();
   cmd->add_option("--split", options.split, "train or test: the two never share a scene")
       ->check(CLI::IsMember({"train", "test"}))
+      ->capture_default_str();
+  cmd->add_option("--scene", options.scene, "street (streets with clutter, cars, pedestrians, cyclists) or cars (a few cars on open "
+                                            "ground, nothing else: quick tests)")
+      ->check(CLI::IsMember({"street", "cars"}))
       ->capture_default_str();
   cmd->add_option("--encoding", options.encoding, "PCD encoding of the scans")
       ->check(CLI::IsMember({"binary", "binary_compressed"}))

@@ -108,6 +108,14 @@ std::string detection_difficulty(double distance_m) {
   return "beyond";
 }
 
+DetectionLayout detection_layout_from_name(const std::string& name) {
+  if (name == "street") return DetectionLayout::kStreet;
+  if (name == "cars") return DetectionLayout::kCars;
+  throw UsageError("--scene: unknown scene '" + name + "' (street or cars)");
+}
+
+std::string detection_layout_name(DetectionLayout layout) { return layout == DetectionLayout::kCars ? "cars" : "street"; }
+
 std::uint64_t detection_scene_seed(std::uint64_t seed, DetectionSplit split, int frame) {
   return sweep_seed(split == DetectionSplit::kTest ? seed ^ kTestSalt : seed, static_cast<std::uint64_t>(frame), 0xffffULL);
 }
@@ -126,7 +134,7 @@ void write_detection_dataset(const DetectionSpec& spec, const fs::path& out, con
   std::vector<double> stamps;
   for (int frame = 0; frame < spec.frames; ++frame) {
     const std::uint64_t scene_seed = detection_scene_seed(spec.seed, spec.split, frame);
-    const Scene scene = detection_scene(scene_seed);
+    const Scene scene = spec.layout == DetectionLayout::kCars ? cars_scene(scene_seed) : detection_scene(scene_seed);
     PointCounts counts;
     for (std::size_t i = 0; i < spec.rig.lidars.size(); ++i) {
       const SimLidar& lidar = spec.rig.lidars[i];
@@ -153,6 +161,7 @@ void write_detection_dataset(const DetectionSpec& spec, const fs::path& out, con
   const nlohmann::json summary = {{"split", detection_split_name(spec.split)},
                                   {"seed", spec.seed},
                                   {"rig", spec.rig.name},
+                                  {"scene", detection_layout_name(spec.layout)},
                                   {"frames", spec.frames},
                                   {"objects", tally},
                                   {"difficulty_max_m", {{"easy", 20.0}, {"moderate", 30.0}, {"hard", 50.0}}}};

@@ -27,18 +27,24 @@
 namespace mlidar::sim {
 
 enum class DetectionSplit : std::uint8_t { kTrain, kTest };
+/// street: detection_scene's streets (the default); cars: cars_scene's few cars on open ground (quick tests).
+enum class DetectionLayout : std::uint8_t { kStreet, kCars };
 
 struct DetectionSpec {
   SimRig rig;
   int frames = 100;
   std::uint64_t seed = 1;
   DetectionSplit split = DetectionSplit::kTrain;
+  DetectionLayout layout = DetectionLayout::kStreet;
   io::PcdEncoding encoding = io::PcdEncoding::kBinary;
 };
 
 /// "train" / "test"; UsageError otherwise.
 DetectionSplit detection_split_from_name(const std::string& name);
 std::string detection_split_name(DetectionSplit split);
+/// "street" / "cars"; UsageError otherwise.
+DetectionLayout detection_layout_from_name(const std::string& name);
+std::string detection_layout_name(DetectionLayout layout);
 
 /// The difficulty of an object at horizontal distance distance_m: "easy", "moderate", "hard" or "beyond".
 std::string detection_difficulty(double distance_m);

@@ -209,4 +209,25 @@ Scene detection_scene(std::uint64_t seed) {
   return Scene("detection-street", primitives, std::move(objects));
 }
 
+Scene cars_scene(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<Primitive> primitives{make_ground(0.0, Eigen::Vector2d::Zero(), 0.3)};
+  std::vector<LabelledObject> objects;
+  Footprints footprints;
+  const int cars = static_cast<int>(uniform(rng, 3.0, 7.0));
+  for (int tries = 0; tries < 50 * cars && static_cast<int>(objects.size()) < cars; ++tries) {
+    const double range = uniform(rng, 6.0, 25.0), bearing = uniform(rng, -kPi, kPi);
+    const double heading = std::floor(uniform(rng, 0.0, 4.0)) * kPi / 2 + uniform(rng, -0.2, 0.2);  // along or across a road
+    ShapedObject car = make_shaped_object(ObjectClass::kCar, Vec3(range * std::cos(bearing), range * std::sin(bearing), 0.0), heading,
+                                          static_cast<int>(objects.size()) + 1, rng);
+    const double radius = 0.5 * car.label.size.head<2>().norm() + 1.0;
+    const Eigen::Vector2d centre = car.label.centre.head<2>();
+    if (!footprints.free(centre, radius)) continue;
+    footprints.add(centre, radius);
+    primitives.insert(primitives.end(), car.parts.begin(), car.parts.end());
+    objects.push_back(car.label);
+  }
+  return Scene("detection-cars", primitives, std::move(objects));
+}
+
 }  // namespace mlidar::sim

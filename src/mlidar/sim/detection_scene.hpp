@@ -15,7 +15,10 @@
 
 namespace mlidar::sim {
 
-/// The scene for `seed`; objects are numbered 1, 2, ... (Scene::objects()[id - 1]).
+/// The street scene for `seed`; objects are numbered 1, 2, ... (Scene::objects()[id - 1]).
 Scene detection_scene(std::uint64_t seed);
+/// A quick scene for tests and first looks: 3-6 cars standing apart on open ground, 6 to 25 m away, heading along or
+/// across (within 11.5°) as on roads, nothing else (no street, clutter, pedestrians or cyclists).
+Scene cars_scene(std::uint64_t seed);
 
 }  // namespace mlidar::sim
