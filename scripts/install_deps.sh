@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev
   chromium fonts-liberation
   python3-dev pybind11-dev python3-numpy python3-pytest python3-dask python3-distributed
+  libtorch-dev
 )
 
 missing=()

@@ -14,6 +14,7 @@ std::vector<Command> register_commands(CLI::App& app, const CliContext& context)
           register_slam(app, context),
           register_bag(app, context),
           register_perturb(app, context),
+          register_detect(app, context),
           register_eval(app, context),
           register_report(app),
           register_doctor(app),

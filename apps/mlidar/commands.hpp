@@ -42,6 +42,8 @@ Command register_bag(CLI::App& app, const CliContext& context);
 Command register_report(CLI::App& app);
 Command register_doctor(CLI::App& app);
 Command register_perturb(CLI::App& app, const CliContext& context);
+/// `detect train|run`: MLOD on LibTorch (command_detect.cpp); without it the commands say how to get it.
+Command register_detect(CLI::App& app, const CliContext& context);
 /// `fleet run`: the Python package's Dask fleet (command_fleet.cpp).
 Command register_fleet(CLI::App& app);
 
