@@ -7,6 +7,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "mlidar/core/heap_settings.hpp"
 #include "mlidar/detect/detection_frames.hpp"
 #include "mlidar/detect/net/model_weights.hpp"
 #include "mlidar/detect/net/stage1.hpp"
@@ -80,6 +81,7 @@ int main(int argc, char** argv) {
   }
   argc = kept;
   torch::set_num_threads(threads);
+  keep_large_buffers_in_the_heap();  // as the CLI runs
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
