@@ -167,6 +167,18 @@ Placement cyclist_placement(std::mt19937_64& rng, const Street& street) {
   return {{x, kerb + (kerb > 0 ? 1.0 : -1.0) * uniform(rng, 0.5, 1.5)}, uniform(rng, -kPi, kPi), kSidewalkHeight};
 }
 
+/// Puts `object` into the scene when its footprint (a disc `clearance` wider than its box) is free; false otherwise.
+bool place(const ShapedObject& object, double clearance, Footprints& footprints, std::vector<Primitive>& primitives,
+           std::vector<LabelledObject>& objects) {
+  const double radius = 0.5 * object.label.size.head<2>().norm() + clearance;
+  const Eigen::Vector2d centre = object.label.centre.head<2>();
+  if (!footprints.free(centre, radius)) return false;
+  footprints.add(centre, radius);
+  primitives.insert(primitives.end(), object.parts.begin(), object.parts.end());
+  objects.push_back(object.label);
+  return true;
+}
+
 void add_objects(std::mt19937_64& rng, const Street& street, Footprints& footprints, std::vector<Primitive>& primitives,
                  std::vector<LabelledObject>& objects) {
   struct Quota {
@@ -181,15 +193,9 @@ void add_objects(std::mt19937_64& rng, const Street& street, Footprints& footpri
       const Placement at = quota.object_class == ObjectClass::kCar          ? car_placement(rng, street)
                            : quota.object_class == ObjectClass::kPedestrian ? pedestrian_placement(rng, street)
                                                                             : cyclist_placement(rng, street);
-      ShapedObject object = make_shaped_object(quota.object_class, Vec3(at.xy.x(), at.xy.y(), at.ground_z), at.yaw,
-                                               static_cast<int>(objects.size()) + 1, rng);
-      const double radius = 0.5 * object.label.size.head<2>().norm() + 0.2;
-      const Eigen::Vector2d centre = object.label.centre.head<2>();
-      if (!footprints.free(centre, radius)) continue;
-      footprints.add(centre, radius);
-      primitives.insert(primitives.end(), object.parts.begin(), object.parts.end());
-      objects.push_back(object.label);
-      ++placed;
+      const ShapedObject object = make_shaped_object(quota.object_class, Vec3(at.xy.x(), at.xy.y(), at.ground_z), at.yaw,
+                                                     static_cast<int>(objects.size()) + 1, rng);
+      if (place(object, 0.2, footprints, primitives, objects)) ++placed;
     }
   }
 }
@@ -218,14 +224,9 @@ Scene cars_scene(std::uint64_t seed) {
   for (int tries = 0; tries < 50 * cars && static_cast<int>(objects.size()) < cars; ++tries) {
     const double range = uniform(rng, 6.0, 25.0), bearing = uniform(rng, -kPi, kPi);
     const double heading = std::floor(uniform(rng, 0.0, 4.0)) * kPi / 2 + uniform(rng, -0.2, 0.2);  // along or across a road
-    ShapedObject car = make_shaped_object(ObjectClass::kCar, Vec3(range * std::cos(bearing), range * std::sin(bearing), 0.0), heading,
-                                          static_cast<int>(objects.size()) + 1, rng);
-    const double radius = 0.5 * car.label.size.head<2>().norm() + 1.0;
-    const Eigen::Vector2d centre = car.label.centre.head<2>();
-    if (!footprints.free(centre, radius)) continue;
-    footprints.add(centre, radius);
-    primitives.insert(primitives.end(), car.parts.begin(), car.parts.end());
-    objects.push_back(car.label);
+    place(make_shaped_object(ObjectClass::kCar, Vec3(range * std::cos(bearing), range * std::sin(bearing), 0.0), heading,
+                             static_cast<int>(objects.size()) + 1, rng),
+          1.0, footprints, primitives, objects);
   }
   return Scene("detection-cars", primitives, std::move(objects));
 }
