@@ -32,14 +32,6 @@ double perturbation_alpha(const fs::path& folder) {
   return json["alpha"].get<double>();
 }
 
-/// SplitMix64 of a seed and a frame: each frame's perturbation its own stream.
-std::uint64_t frame_seed(std::uint64_t seed, std::size_t k) {
-  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (static_cast<std::uint64_t>(k) + 1);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 LidarPoints lidar_points(const Scan& scan, const SE3& T_base_lidar, const PerturbationPrior& prior) {
   LidarPoints out;
   out.points.reserve(scan.size());
@@ -109,7 +101,7 @@ DetectionFrame DetectionDataset::read(std::size_t k, double alpha, std::uint64_t
   frame.index = k;
   frame.id = frame_id(k);
   const io::SourceFrame source = source_.read(k);
-  std::mt19937_64 rng(frame_seed(seed, k));
+  std::mt19937_64 rng(mix_seed(seed, k));
   for (std::size_t j = 0; j < source.scans.size(); ++j) {
     PerturbationPrior prior;
     prior.alpha = j == reference_ ? 0.0 : (alpha > 0.0 ? alpha : dataset_alpha_);
@@ -156,6 +148,13 @@ void augment_frame(const Augmentation& augmentation, DetectionFrame& frame) {
     for (Vec3& p : lidar.points) p = augment_point(augmentation, p);
   }
   for (io::LabelledBox& label : frame.labels) label.box = augment_box(augmentation, label.box);
+}
+
+std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (stream + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
 }
 
 std::vector<io::Box3D> boxes_of_class(std::span<const io::LabelledBox> labels, io::ObjectClass object_class) {

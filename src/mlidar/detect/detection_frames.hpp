@@ -86,6 +86,9 @@ io::Box3D augment_box(const Augmentation& augmentation, const io::Box3D& box);
 /// The frame's points and labels augmented alike.
 void augment_frame(const Augmentation& augmentation, DetectionFrame& frame);
 
+/// SplitMix64 of `seed` and a stream index: independent seeds per frame (perturbations) or per step (training).
+std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t stream);
+
 /// The boxes of one class.
 std::vector<io::Box3D> boxes_of_class(std::span<const io::LabelledBox> labels, io::ObjectClass object_class);
 

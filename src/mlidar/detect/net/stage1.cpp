@@ -61,20 +61,20 @@ Stage1Targets stage1_targets(std::span<const io::Box3D> boxes, std::span<const V
   return out;
 }
 
-Stage1Loss stage1_loss(const std::vector<torch::Tensor>& output, long item, const Stage1Targets& targets, const Stage1TrainConfig& config) {
-  const torch::Tensor logits = output[0][item];
-  const torch::Tensor valid = targets.label.ge(0);
-  const torch::Tensor positive = targets.label.eq(1);
-  const double normalizer = std::max<long>(1, targets.positives);
-  // Focal loss FL(p_t) = -alpha_t (1 - p_t)^gamma log p_t (Lin et al. 2017), on the anchors that are not ignored.
-  const torch::Tensor y = targets.label.clamp_min(0.0);
+torch::Tensor focal_loss_sum(const torch::Tensor& logits, const torch::Tensor& labels, double alpha, double gamma) {
+  const torch::Tensor y = labels.clamp_min(0.0);
   const torch::Tensor p = torch::sigmoid(logits);
   const torch::Tensor p_t = y * p + (1 - y) * (1 - p);
-  const torch::Tensor alpha_t = y * config.focal_alpha + (1 - y) * (1 - config.focal_alpha);
+  const torch::Tensor alpha_t = y * alpha + (1 - y) * (1 - alpha);
   const torch::Tensor bce = torch::binary_cross_entropy_with_logits(logits, y, {}, {}, torch::Reduction::None);
-  const torch::Tensor focal = alpha_t * (1 - p_t).pow(config.focal_gamma) * bce;
+  return (alpha_t * (1 - p_t).pow(gamma) * bce * labels.ge(0)).sum();
+}
+
+Stage1Loss stage1_loss(const std::vector<torch::Tensor>& output, long item, const Stage1Targets& targets, const Stage1TrainConfig& config) {
+  const torch::Tensor positive = targets.label.eq(1);
+  const double normalizer = std::max<long>(1, targets.positives);
   Stage1Loss loss;
-  loss.classification = (focal * valid).sum() / normalizer;
+  loss.classification = focal_loss_sum(output[0][item], targets.label, config.focal_alpha, config.focal_gamma) / normalizer;
   if (targets.positives > 0) {
     const torch::Tensor index = positive.nonzero().squeeze(1);
     // SECOND's sine difference: the heading residual compared as sin(p - t) = sin p cos t - cos p sin t, smooth across

@@ -27,6 +27,10 @@ struct Stage1Targets {
 };
 Stage1Targets stage1_targets(std::span<const io::Box3D> boxes, std::span<const Vec3> points, const DetectConfig& config);
 
+/// Focal loss FL(p_t) = -alpha_t (1 - p_t)^gamma log p_t (Lin et al. 2017) of each logit against its label (1
+/// positive, 0 negative, -1 ignored: no loss), summed. Both stages classify with it.
+torch::Tensor focal_loss_sum(const torch::Tensor& logits, const torch::Tensor& labels, double alpha, double gamma);
+
 struct Stage1Loss {
   torch::Tensor total, classification, regression, direction;
 };

@@ -66,15 +66,9 @@ Stage2Targets stage2_targets(std::span<const Proposal> proposals, std::span<cons
 }
 
 Stage2Loss stage2_loss(const std::vector<torch::Tensor>& output, const Stage2Targets& targets, const Stage2Input& input, const Stage2Config& config) {
-  const torch::Tensor& logits = output[0];
   const double normalizer = std::max<long>(1, targets.positives);
-  const torch::Tensor y = targets.label.clamp_min(0.0);
-  const torch::Tensor p = torch::sigmoid(logits);
-  const torch::Tensor p_t = y * p + (1 - y) * (1 - p);
-  const torch::Tensor alpha_t = y * 0.25 + (1 - y) * 0.75;
-  const torch::Tensor bce = torch::binary_cross_entropy_with_logits(logits, y, {}, {}, torch::Reduction::None);
   Stage2Loss loss;
-  loss.classification = (alpha_t * (1 - p_t).pow(2.0) * bce * targets.label.ge(0)).sum() / normalizer;  // eq 6.15, f_cls
+  loss.classification = focal_loss_sum(output[0], targets.label, 0.25, 2.0) / normalizer;  // eq 6.15, f_cls
   if (targets.positives > 0) {
     const torch::Tensor index = targets.label.eq(1).nonzero().squeeze(1);
     const torch::Tensor u = output[1].index_select(0, index);

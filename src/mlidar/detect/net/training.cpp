@@ -23,13 +23,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr long kLogEvery = 10;  ///< steps per line of train_log.jsonl (the mean loss of those steps)
 
-std::uint64_t mix(std::uint64_t a, std::uint64_t b) {
-  std::uint64_t z = a + 0x9e3779b97f4a7c15ULL * (b + 1);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 /// What both stages share: the data, the model's LiDARs, the folder.
 struct Session {
   const TrainRequest& request;
@@ -47,7 +40,7 @@ struct Session {
 std::size_t frame_of_step(const Session& session, int stage, long step) {
   const auto n = static_cast<long>(session.train_frames.size());
   std::vector<std::size_t> order = session.train_frames;
-  std::mt19937_64 rng(mix(mix(session.config.seed, static_cast<std::uint64_t>(stage)), static_cast<std::uint64_t>(step / n)));
+  std::mt19937_64 rng(mix_seed(mix_seed(session.config.seed, static_cast<std::uint64_t>(stage)), static_cast<std::uint64_t>(step / n)));
   std::shuffle(order.begin(), order.end(), rng);
   return order[static_cast<std::size_t>(step % n)];
 }
@@ -115,14 +108,16 @@ long stage_steps(const Session& session, int epochs) {
   return session.request.max_steps > 0 ? std::min(steps, session.request.max_steps) : steps;
 }
 
-/// The points each batch item of stage 1 sees (for its targets): per LiDAR with result fusion, else all together.
-std::vector<std::vector<Vec3>> item_points(const DetectionFrame& frame, Fusion fusion) {
+/// The points each batch item of stage 1 sees (for its targets): per LiDAR with result fusion, else all together
+/// (`merged` holds them).
+std::vector<std::span<const Vec3>> item_points(const DetectionFrame& frame, Fusion fusion, LidarPoints& merged) {
+  std::vector<std::span<const Vec3>> items;
   if (fusion == Fusion::kResult) {
-    std::vector<std::vector<Vec3>> items;
-    for (const LidarPoints& lidar : frame.lidars) items.push_back(lidar.points);
+    for (const LidarPoints& lidar : frame.lidars) items.emplace_back(lidar.points);
     return items;
   }
-  return {merge_lidars(frame).points};
+  merged = merge_lidars(frame);
+  return {merged.points};
 }
 
 /// Each LiDAR's score temperature from the validation frames' detections (eq 6.11's calibration); 1 without any.
@@ -159,12 +154,13 @@ void train_stage1(Session& session) {
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(config.stage1.learning_rate).weight_decay(config.stage1.weight_decay));
   const long steps = stage_steps(session, config.stage1.epochs);
   session.records[1] = run_loop(session, 1, *net, optimizer, config.stage1.learning_rate, steps, [&](long step) {
-    std::mt19937_64 rng(mix(mix(config.seed, 1), static_cast<std::uint64_t>(step) + 1000003));
+    std::mt19937_64 rng(mix_seed(mix_seed(config.seed, 1), static_cast<std::uint64_t>(step) + 1000003));
     DetectionFrame frame = select_lidars(session.dataset.read(frame_of_step(session, 1, step)), session.lidar_indices);
     augment_frame(draw_augmentation(config.augment, false, rng), frame);
     const std::vector<io::Box3D> boxes = boxes_of_class(frame.labels, config.object_class);
     const std::vector<torch::Tensor> output = net::run_stage1(net, net::stage1_grids(frame, fusion, config.grid), fusion);
-    const std::vector<std::vector<Vec3>> points = item_points(frame, fusion);
+    LidarPoints merged;
+    const std::vector<std::span<const Vec3>> points = item_points(frame, fusion, merged);
     torch::Tensor total = torch::zeros({}, torch::kFloat32);
     std::map<std::string, double> terms;
     for (std::size_t item = 0; item < points.size(); ++item) {
@@ -200,7 +196,7 @@ void train_stage2(Session& session) {
   const long steps = stage_steps(session, config.stage2.epochs);
   const bool inject = session.dataset.dataset_alpha() == 0.0 && !config.stage2.alphas.empty();
   session.records[2] = run_loop(session, 2, *refiner, optimizer, config.stage2.learning_rate, steps, [&](long step) {
-    std::mt19937_64 rng(mix(mix(config.seed, 2), static_cast<std::uint64_t>(step) + 1000003));
+    std::mt19937_64 rng(mix_seed(mix_seed(config.seed, 2), static_cast<std::uint64_t>(step) + 1000003));
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     // 6.6.1.6: about 1 clean sample for 1.5 uncertain ones, each uncertain one at a level drawn from the alphas.
     const bool uncertain = inject && unit(rng) < config.stage2.uncertain_share;
