@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
-#include <numeric>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -19,6 +18,7 @@
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/detection_labels.hpp"
 #include "mlidar/io/run_folder.hpp"
+#include "mlidar/pipelines/odometry_metrics.hpp"
 #if MLIDAR_WITH_DETECT
 #include "mlidar/detect/net/detector.hpp"
 #endif
@@ -96,18 +96,6 @@ int run_train(const TrainOptions& options) {
   return 0;
 }
 
-double percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  return values[static_cast<std::size_t>(std::min<double>(values.size() - 1, std::floor(q * static_cast<double>(values.size() - 1) + 0.5)))];
-}
-
-nlohmann::json timing_json(const std::vector<double>& values) {
-  const double mean = values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
-  return {{"mean", mean}, {"median", percentile(values, 0.5)}, {"p95", percentile(values, 0.95)},
-          {"max", values.empty() ? 0.0 : *std::max_element(values.begin(), values.end())}};
-}
-
 int run_detect(const RunOptions& options, const CliContext& context) {
   const detect::Detector detector = detect::Detector::load(options.model, options.stage, options.threads);
   const detect::DetectionDataset dataset = detect::DetectionDataset::open(options.dataset, /*need_labels=*/false);
@@ -146,10 +134,10 @@ int run_detect(const RunOptions& options, const CliContext& context) {
                                   {"threads", options.threads > 0 ? options.threads : detector.config().threads},
                                   {"frames", dataset.frames()},
                                   {"detections", detections},
-                                  {"detect_ms", timing_json(total_ms)},
-                                  {"stage1_ms", timing_json(stage1_ms)},
-                                  {"stage2_ms", timing_json(stage2_ms)},
-                                  {"read_ms", timing_json(read_ms)},
+                                  {"detect_ms", pipelines::timing_summary(total_ms)},
+                                  {"stage1_ms", pipelines::timing_summary(stage1_ms)},
+                                  {"stage2_ms", pipelines::timing_summary(stage2_ms)},
+                                  {"read_ms", pipelines::timing_summary(read_ms)},
                                   {"per_frame", per_frame}};
   io::write_atomically(run.path() / "metrics.json", [&](std::ostream& out) { out << metrics.dump(2) << '\n'; });
   run.commit();
