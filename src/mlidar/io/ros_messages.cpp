@@ -140,7 +140,8 @@ PointTable to_table(const PointCloud2& cloud, std::span<const std::byte> data, c
     if (only != nullptr && std::find(only->begin(), only->end(), f.name) == only->end()) continue;
     FieldColumn& column = table.add_field(f.name, type, static_cast<std::uint32_t>(count));
     const bool swap = cloud.is_bigendian != (std::endian::native == std::endian::big);
-    copy_field(data, cloud, f.offset, size * count, size, swap, column.data.data());
+    // Not when empty: a width of 0 under a height of 10^9 would walk every empty row.
+    if (points > 0) copy_field(data, cloud, f.offset, size * count, size, swap, column.data.data());
   }
   return table;
 }
