@@ -15,6 +15,8 @@
 #include "mlidar/core/error.hpp"
 #include "mlidar/detect/detect_config.hpp"
 #include "mlidar/detect/model_folder.hpp"
+#include "mlidar/detect/online_calibration_log.hpp"
+#include "mlidar/detect/online_extrinsics.hpp"
 #include "mlidar/io/atomic_file.hpp"
 #include "mlidar/io/detection_labels.hpp"
 #include "mlidar/io/run_folder.hpp"
@@ -43,9 +45,31 @@ struct RunOptions {
   int stage = 0;
   int threads = 0;
   bool overwrite = false;
+  bool refine_extrinsics = false;
 };
 
 #if MLIDAR_WITH_DETECT
+
+/// metrics.json's "online_calibration": per LiDAR what the registrations did (summaries as {mean, p50, p95, max}).
+nlohmann::json online_calibration_json(const detect::OnlineCalibrationLog& log) {
+  nlohmann::json lidars = nlohmann::json::array();
+  for (const detect::LidarRefineRecord& record : log.records()) {
+    if (record.registrations == 0) continue;
+    nlohmann::json lidar = {{"lidar", record.lidar},
+                            {"registrations", record.registrations},
+                            {"trusted", record.trusted},
+                            {"rotation_change_deg", pipelines::timing_summary(record.rotation_change_deg)},
+                            {"translation_change_m", pipelines::timing_summary(record.translation_change_m)}};
+    if (log.knows_truth()) {
+      lidar["rotation_error_deg"] = {{"given", pipelines::timing_summary(record.rotation_error_given_deg)},
+                                     {"used", pipelines::timing_summary(record.rotation_error_used_deg)}};
+      lidar["translation_error_m"] = {{"given", pipelines::timing_summary(record.translation_error_given_m)},
+                                      {"used", pipelines::timing_summary(record.translation_error_used_m)}};
+    }
+    lidars.push_back(lidar);
+  }
+  return {{"registrations", log.registrations()}, {"untrusted", log.untrusted()}, {"lidars", lidars}};
+}
 
 std::string clock_text(double seconds) {
   const long s = std::lround(std::max(0.0, seconds));
@@ -108,10 +132,15 @@ int run_detect(const RunOptions& options, const CliContext& context) {
   nlohmann::json per_frame = nlohmann::json::array();
   std::vector<double> read_ms, stage1_ms, stage2_ms, total_ms;
   std::size_t detections = 0;
+  // The truth is known where the perturbations are drawn here, about the dataset's own extrinsics.
+  detect::OnlineCalibrationLog online_log(dataset.lidar_names(), options.alpha > 0.0 ? dataset.dataset_extrinsics() : std::vector<SE3>{});
+  const calib::PairRefineConfig online = detect::online_refine_config();
   const auto progress = terminal_progress_bar();
   for (std::size_t k = 0; k < dataset.frames(); ++k) {
     const Clock::time_point start = Clock::now();
-    const detect::DetectionFrame frame = detect::select_lidars(dataset.read(k, options.alpha, options.seed), indices);
+    detect::DetectionFrame all = dataset.read(k, options.alpha, options.seed, options.refine_extrinsics ? &online : nullptr);
+    online_log.add(all);
+    const detect::DetectionFrame frame = detect::select_lidars(std::move(all), indices);
     const double read = ms(start);
     const detect::FrameDetections result = detector.detect(frame);
     io::write_detection_labels(run.path() / "label_2" / (frame.id + ".txt"), result.boxes);
@@ -131,6 +160,8 @@ int run_detect(const RunOptions& options, const CliContext& context) {
                                   {"stages_run", stages},
                                   {"alpha", options.alpha},
                                   {"seed", options.seed},
+                                  {"refine_extrinsics", options.refine_extrinsics},
+                                  {"online_calibration", options.refine_extrinsics ? online_calibration_json(online_log) : nlohmann::json(nullptr)},
                                   {"threads", options.threads > 0 ? options.threads : detector.config().threads},
                                   {"frames", dataset.frames()},
                                   {"detections", detections},
@@ -145,6 +176,10 @@ int run_detect(const RunOptions& options, const CliContext& context) {
             << metrics["detect_ms"]["mean"].get<double>() << " ms per frame (mean, stages";
   for (const int stage : stages) std::cout << ' ' << stage;
   std::cout << ")\n";
+  if (online_log.untrusted() > 0) {
+    std::cerr << "warning: online calibration did not trust " << online_log.untrusted() << " of " << online_log.registrations()
+              << " registrations; those LiDARs kept the given extrinsic in those frames (metrics.json: online_calibration)\n";
+  }
   return 0;
 }
 
@@ -183,6 +218,9 @@ void add_run(CLI::App& detect, RunOptions& options) {
   sub->add_option("--alpha", options.alpha, "Perturb every frame's extrinsics anew at this level (thesis 6.6.1.3, 0 to 0.1)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--seed", options.seed, "Seed of the --alpha perturbations (one per trial)")->capture_default_str();
+  sub->add_flag("--refine-extrinsics", options.refine_extrinsics,
+                "Online calibration first (the thesis's (OC)): each frame's extrinsics registered to the reference LiDAR's "
+                "scan by `calibrate refine`'s ICP; metrics.json's online_calibration says what it did");
   sub->add_option("--stage", options.stage, "1: stage 1 alone (of a two-stage model); 2: require stage 2; default all trained stages")
       ->check(CLI::Range(1, 2));
   sub->add_option("--threads", options.threads, "LibTorch threads (default: the model's configuration)")->check(CLI::Range(1, 256));

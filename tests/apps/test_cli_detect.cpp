@@ -53,9 +53,25 @@ TEST(CliDetect, TrainsAndRunsIntoTheDocumentedFiles) {
   ASSERT_EQ(metrics["per_frame"].size(), 2U);
   EXPECT_GT(metrics["per_frame"][0]["stage1_ms"].get<double>(), 0.0);
   EXPECT_GT(metrics["per_frame"][0]["stage2_ms"].get<double>(), 0.0);
+  EXPECT_EQ(metrics["refine_extrinsics"], false);
+  EXPECT_TRUE(metrics["online_calibration"].is_null());
   // The predictions are label_2 lines with a score: eval detections reads them.
   r = run_cli("eval detections --gt " + quoted(data.string()) + " --pred " + quoted((dir / "pred").string()) + " --classes car");
   EXPECT_EQ(r.exit_code, 0) << r.output;
+  // Online calibration first: both other LiDARs registered in both frames, their errors against the truth reported.
+  r = run_cli("detect run --model " + quoted(model.string()) + " --dataset " + quoted(data.string()) +
+              " --alpha 0.1 --refine-extrinsics --out " + quoted((dir / "pred_oc").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json oc = nlohmann::json::parse(read_text(dir / "pred_oc" / "metrics.json"));
+  EXPECT_EQ(oc["refine_extrinsics"], true);
+  const nlohmann::json& online = oc["online_calibration"];
+  EXPECT_EQ(online["registrations"], 4);
+  ASSERT_EQ(online["lidars"].size(), 2U);
+  for (const auto& lidar : online["lidars"]) {
+    SCOPED_TRACE(lidar.dump());
+    EXPECT_EQ(lidar["registrations"], 2);
+    EXPECT_LT(lidar["rotation_error_deg"]["used"]["max"].get<double>(), lidar["rotation_error_deg"]["given"]["max"].get<double>());
+  }
 }
 
 TEST(CliDetect, BadInputExitsWithTheReason) {

@@ -8,6 +8,7 @@
 
 #include "mlidar/core/error.hpp"
 #include "mlidar/core/extrinsic_perturbation.hpp"
+#include "mlidar/detect/online_extrinsics.hpp"
 #include "mlidar/io/file_bytes.hpp"
 
 namespace mlidar::detect {
@@ -32,20 +33,20 @@ double perturbation_alpha(const fs::path& folder) {
   return json["alpha"].get<double>();
 }
 
-LidarPoints lidar_points(const Scan& scan, const SE3& T_base_lidar, const PerturbationPrior& prior) {
+/// The scan's points in the base frame by pose.T, with tr(Xi) (eq 6.7) under pose's covariance when `uncertain`
+/// (else 3 sigma_z^2, the clean value).
+LidarPoints lidar_points(const Scan& scan, const UncertainPose& pose, const Mat3& Z, bool uncertain) {
   LidarPoints out;
   out.points.reserve(scan.size());
   out.intensity.reserve(scan.size());
   out.uncertainty.reserve(scan.size());
-  const Mat3 Z = prior_point_noise(prior);
-  const UncertainPose pose = uncertain_extrinsic(T_base_lidar, prior);
   const double clean = Z.trace();
   for (std::size_t i = 0; i < scan.size(); ++i) {
     const Vec3 p = scan.points[i].cast<double>();
     if (!p.allFinite()) continue;
-    out.points.push_back(T_base_lidar * p);
+    out.points.push_back(pose.T * p);
     out.intensity.push_back(scan.has_intensity() ? scan.intensity[i] : 0.0f);
-    out.uncertainty.push_back(prior.alpha > 0.0 ? point_covariance(pose, p, Z).trace() : clean);  // eq 6.7
+    out.uncertainty.push_back(uncertain ? point_covariance(pose, p, Z).trace() : clean);  // eq 6.7
   }
   return out;
 }
@@ -54,8 +55,13 @@ LidarPoints lidar_points(const Scan& scan, const SE3& T_base_lidar, const Pertur
 
 DetectionFrame select_lidars(DetectionFrame frame, const std::vector<std::size_t>& indices) {
   std::vector<LidarPoints> selected;
-  for (const std::size_t j : indices) selected.push_back(std::move(frame.lidars.at(j)));
+  std::vector<LidarPlacement> placements;
+  for (const std::size_t j : indices) {
+    selected.push_back(std::move(frame.lidars.at(j)));
+    if (j < frame.placements.size()) placements.push_back(frame.placements[j]);
+  }
   frame.lidars = std::move(selected);
+  frame.placements = std::move(placements);
   return frame;
 }
 
@@ -92,7 +98,8 @@ DetectionDataset DetectionDataset::open(const fs::path& folder, bool need_labels
   return dataset;
 }
 
-DetectionFrame DetectionDataset::read(std::size_t k, double alpha, std::uint64_t seed) const {
+DetectionFrame DetectionDataset::read(std::size_t k, double alpha, std::uint64_t seed,
+                                      const calib::PairRefineConfig* online_calibration) const {
   if (alpha > 0.0 && dataset_alpha_ > 0.0) {
     throw UsageError(folder_.string() + " is already perturbed (alpha " + std::to_string(dataset_alpha_) +
                      "); give --alpha with its clean source dataset, or leave --alpha out");
@@ -102,11 +109,29 @@ DetectionFrame DetectionDataset::read(std::size_t k, double alpha, std::uint64_t
   frame.id = frame_id(k);
   const io::SourceFrame source = source_.read(k);
   std::mt19937_64 rng(mix_seed(seed, k));
+  const std::optional<Scan>& reference = source.scans[reference_];
   for (std::size_t j = 0; j < source.scans.size(); ++j) {
     PerturbationPrior prior;
     prior.alpha = j == reference_ ? 0.0 : (alpha > 0.0 ? alpha : dataset_alpha_);
-    const SE3 T_base_lidar = alpha > 0.0 && j != reference_ ? sample_perturbed_extrinsic(T_base_lidar_[j], prior, rng) : T_base_lidar_[j];
-    frame.lidars.push_back(source.scans[j] ? lidar_points(*source.scans[j], T_base_lidar, prior) : LidarPoints{});
+    LidarPlacement placement;
+    placement.T_base_lidar_given =
+        alpha > 0.0 && j != reference_ ? sample_perturbed_extrinsic(T_base_lidar_[j], prior, rng) : T_base_lidar_[j];
+    UncertainPose pose = uncertain_extrinsic(placement.T_base_lidar_given, prior);
+    bool uncertain = prior.alpha > 0.0;
+    const std::optional<Scan>& scan = source.scans[j];
+    if (online_calibration != nullptr && j != reference_ && scan && reference) {
+      const RefinedExtrinsic refined =
+          refine_extrinsic_online(*reference, T_base_lidar_[reference_], *scan, placement.T_base_lidar_given, *online_calibration);
+      placement.refine_ran = true;
+      placement.refine_verdict = refined.registration.verdict;
+      if (refined.trusted) {
+        pose = refined.uncertain_extrinsic;
+        uncertain = true;
+      }
+    }
+    placement.T_base_lidar = pose.T;
+    frame.placements.push_back(placement);
+    frame.lidars.push_back(scan ? lidar_points(*scan, pose, prior_point_noise(prior), uncertain) : LidarPoints{});
   }
   if (has_labels_) {
     const fs::path path = folder_ / "groundtruth" / "label_2" / (frame.id + ".txt");

@@ -7,7 +7,9 @@
 //   - a `perturb` copy: its perturbed extrinsics, the prior at its alpha (groundtruth/perturbation.json) for every
 //     LiDAR but the reference;
 //   - `alpha` > 0 asked for: each frame's extrinsics drawn anew from the dataset's (eq 6.1-6.2, every component
-//     bounded at its sigma, 6.6.1.3) with a seed of its own, the prior at that alpha (Fig 6.5's trials).
+//     bounded at its sigma, 6.6.1.3) with a seed of its own, the prior at that alpha (Fig 6.5's trials);
+//   - online calibration asked for (the "(OC)" rows): each LiDAR's extrinsic of the frame, as above, refined against
+//     the reference's scan first (online_extrinsics.hpp).
 // Augmentation (6.6.1.5-6.6.1.6): a flip about the x axis, a turn about z, a shift and a scale applied to points and
 // boxes alike.
 #include <cstdint>
@@ -16,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "mlidar/calib/pair_refine.hpp"
 #include "mlidar/core/se3.hpp"
 #include "mlidar/detect/detect_config.hpp"
 #include "mlidar/io/detection_labels.hpp"
@@ -30,10 +33,19 @@ struct LidarPoints {
   std::vector<double> uncertainty;  ///< tr(Xi) of each point, m^2 (eq 6.7)
 };
 
+/// How one LiDAR's points of a frame were placed in the base frame.
+struct LidarPlacement {
+  SE3 T_base_lidar_given;      ///< the dataset's extrinsic, or its perturbation drawn for the frame
+  SE3 T_base_lidar;            ///< the one the points were moved by: the given one, or online calibration's
+  bool refine_ran = false;     ///< online calibration registered this LiDAR in this frame
+  calib::PairVerdict refine_verdict = calib::PairVerdict::kNotConverged;  ///< when it ran
+};
+
 struct DetectionFrame {
   std::size_t index = 0;
   std::string id;                      ///< "000042": the label and prediction file's stem
   std::vector<LidarPoints> lidars;     ///< dataset order; empty points where a LiDAR has no scan
+  std::vector<LidarPlacement> placements;  ///< one per LiDAR, in the order of `lidars`
   std::vector<io::LabelledBox> labels; ///< every class; empty without labels
 };
 
@@ -58,8 +70,13 @@ class DetectionDataset {
   bool has_labels() const { return has_labels_; }
   const std::filesystem::path& folder() const { return folder_; }
 
+  /// The extrinsics of dataset.yaml (the truth the `alpha` perturbations are drawn about).
+  const std::vector<SE3>& dataset_extrinsics() const { return T_base_lidar_; }
+
   /// Frame k (see the header comment). `alpha` > 0 on a dataset that is itself perturbed is a UsageError.
-  DetectionFrame read(std::size_t k, double alpha = 0.0, std::uint64_t seed = 0) const;
+  /// `online_calibration`: refine every LiDAR's extrinsic against the reference's scan of the frame with it.
+  DetectionFrame read(std::size_t k, double alpha = 0.0, std::uint64_t seed = 0,
+                      const calib::PairRefineConfig* online_calibration = nullptr) const;
 
  private:
   DetectionDataset(std::filesystem::path folder, io::FrameSource source) : folder_(std::move(folder)), source_(std::move(source)) {}
