@@ -5,8 +5,9 @@
 # 2. Table 6.2: single-LiDAR detectors (top, front_left, front_right; stage 1) and the three fusions (stage 1 and
 #    MLOD's stage 2), each trained on the train split and run on the test split; one markdown row per case:
 #    AP3D R40 at IoU 0.7 and 0.5, easy / moderate / hard, and the mean detect time per frame.
-# 3. Fig 6.5: each fusion's stage 1 and MLOD under extrinsic perturbation, alpha in {0, 0.02, 0.04, 0.1}, TRIALS
-#    seeds each (`detect run --alpha A --seed S`): mean and standard deviation of AP3D R40 at IoU 0.7, moderate.
+# 3. Fig 6.5: each fusion's stage 1, MLOD, and MLOD with online calibration first ("(OC)", `--refine-extrinsics`)
+#    under extrinsic perturbation, alpha in {0, 0.02, 0.04, 0.1}, TRIALS seeds each (`detect run --alpha A --seed S`):
+#    mean and standard deviation of AP3D R40 at IoU 0.7, moderate.
 # Models are kept in WORK_DIR: a second run reuses them (and `--resume`s an interrupted training).
 set -euo pipefail
 build=${1:?BUILD_DIR}; work=${2:?WORK_DIR}
@@ -62,19 +63,25 @@ done
 echo
 echo "| case | alpha | AP3D R40 @0.7 moderate: mean | sd | trials |"
 echo "|---|---|---|---|---|"
+# Stage 1 alone, MLOD (both stages), and MLOD with online calibration first (the thesis's "(OC)" rows:
+# `detect run --refine-extrinsics`); "oc" stands for the last.
 for fusion in input feature result; do
-  for stage in 1 2; do
+  for stage in 1 2 oc; do
+    run_args=(--stage "${stage/oc/2}")
+    [[ $stage == oc ]] && run_args+=(--refine-extrinsics)
     for alpha in 0 0.02 0.04 0.1; do
       values=()
       for seed in $(seq 1 "$trials"); do
         pred="$work/perturbed-$fusion-$stage-$alpha-$seed"; rm -rf "$pred"
-        "$mlidar" detect run --model "$work/model-$fusion" --dataset "$test" --stage "$stage" --alpha "$alpha" --seed "$seed" --out "$pred" > /dev/null
+        "$mlidar" detect run --model "$work/model-$fusion" --dataset "$test" "${run_args[@]}" --alpha "$alpha" --seed "$seed" --out "$pred" > /dev/null 2>&1
         "$mlidar" eval detections --gt "$test" --pred "$pred" --classes car --json "$pred/ap.json" > /dev/null
         values+=("$(jq '.classes.car.strict.moderate."3d".ap_r40' "$pred/ap.json")")
         rm -rf "$pred/label_2"
         [[ $alpha == 0 ]] && break  # no perturbation: every trial is the same
       done
-      printf '%s\n' "${values[@]}" | awk -v c="$fusion stage $stage" -v a="$alpha" \
+      name="$fusion stage $stage"
+      [[ $stage == oc ]] && name="$fusion MLOD (OC)"
+      printf '%s\n' "${values[@]}" | awk -v c="$name" -v a="$alpha" \
         '{ s += $1; q += $1 * $1; n++ } END { m = s / n; v = q / n - m * m; printf "| %s | %s | %.1f | %.1f | %d |\n", c, a, m, (v > 0 ? sqrt(v) : 0), n }'
     done
   done
