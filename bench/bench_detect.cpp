@@ -1,14 +1,22 @@
 // Detection hot paths without a network (issue 23's 200 ms per frame for 3 LiDARs on 2 threads leaves these a few
 // ms): a lyft-sized frame's 200 000 points into the stage-1 BEV grid (96 m x 96 m, 0.4 m pillars), 30 cars'
-// anchor targets on its head grid (stride 2, two yaws: 28 800 anchors), and result fusion of 3 LiDARs x 100 boxes.
+// anchor targets on its head grid (stride 2, two yaws: 28 800 anchors), result fusion of 3 LiDARs x 100 boxes, and
+// online calibration of a simulated lyft street frame (both side LiDARs registered to the top one, alpha 0.04).
+#include <filesystem>
 #include <numbers>
 #include <random>
+#include <unistd.h>
 
 #include <benchmark/benchmark.h>
 
+#include "mlidar/core/extrinsic_perturbation.hpp"
 #include "mlidar/detect/anchor_targets.hpp"
 #include "mlidar/detect/bev_grid.hpp"
+#include "mlidar/detect/online_extrinsics.hpp"
 #include "mlidar/detect/result_fusion.hpp"
+#include "mlidar/io/frame_source.hpp"
+#include "mlidar/sim/detection_dataset.hpp"
+#include "mlidar/sim/rig.hpp"
 
 namespace {
 
@@ -51,5 +59,43 @@ void BM_ResultFusion3x100(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(detect::fuse_results(lidars, 0.1));
 }
 BENCHMARK(BM_ResultFusion3x100)->Unit(benchmark::kMillisecond);
+
+/// Arg 0: online_refine_config(); 1: `calibrate refine`'s defaults without the search. Counters: trusted share and
+/// mean rotation error (deg) against the simulator's extrinsics.
+void BM_OnlineCalibrationLyftFrame(benchmark::State& state) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / ("mlidar_bench_oc_" + std::to_string(::getpid()));
+  sim::DetectionSpec spec;
+  spec.rig = sim::load_rig("lyft");
+  spec.frames = 1;
+  spec.split = sim::DetectionSplit::kTest;
+  sim::write_detection_dataset(spec, folder);
+  const io::FrameSource source = io::FrameSource::dataset(folder);
+  const io::SourceFrame frame = source.read(0);
+  std::filesystem::remove_all(folder);
+  const std::size_t ref = source.reference_index().value_or(0);
+  calib::PairRefineConfig config = detect::online_refine_config();
+  if (state.range(0) == 1) {
+    config = calib::PairRefineConfig{};
+    config.search_mode = calib::PairSearchMode::kNever;
+  }
+  std::mt19937_64 rng(4);
+  double trusted = 0.0, error_deg = 0.0, registrations = 0.0;
+  for (auto _ : state) {
+    for (std::size_t j = 0; j < source.lidars().size(); ++j) {
+      if (j == ref) continue;
+      const SE3 truth = *source.lidars()[j].initial_extrinsic;
+      PerturbationPrior prior;
+      prior.alpha = 0.04;
+      const detect::RefinedExtrinsic refined = detect::refine_extrinsic_online(
+          *frame.scans[ref], *source.lidars()[ref].initial_extrinsic, *frame.scans[j], sample_perturbed_extrinsic(truth, prior, rng), config);
+      trusted += refined.trusted ? 1.0 : 0.0;
+      error_deg += (truth.rotation().inverse() * refined.T_base_lidar.rotation()).angularDistance(Quat::Identity()) * 180.0 / std::numbers::pi;
+      registrations += 1.0;
+    }
+  }
+  state.counters["trusted"] = trusted / registrations;
+  state.counters["rot_err_deg"] = error_deg / registrations;
+}
+BENCHMARK(BM_OnlineCalibrationLyftFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -17,7 +17,7 @@ struct RefinedExtrinsic {
   calib::PairRefineResult registration;
 };
 
-/// calib::PairRefineConfig's defaults (those of `calibrate refine`) without the search.
+/// Online calibration's registration: `calibrate refine`'s without the search, lighter (see the .cpp for the numbers).
 calib::PairRefineConfig online_refine_config();
 
 /// Registers `lidar` (its own frame) to `reference` (its own frame) from T_base_lidar_given; the reference's extrinsic
