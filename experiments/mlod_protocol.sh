@@ -5,8 +5,8 @@
 # 2. Table 6.2: single-LiDAR detectors (top, front_left, front_right; stage 1) and the three fusions (stage 1 and
 #    MLOD's stage 2), each trained on the train split and run on the test split; one markdown row per case:
 #    AP3D R40 at IoU 0.7 and 0.5, easy / moderate / hard, and the mean detect time per frame.
-# 3. Fig 6.5: each fusion's stage 1, MLOD, and MLOD with online calibration first ("(OC)", `--refine-extrinsics`)
-#    under extrinsic perturbation, alpha in {0, 0.02, 0.04, 0.1}, TRIALS seeds each (`detect run --alpha A --seed S`):
+# 3. Fig 6.5: each fusion's stage 1 and MLOD, each also with online calibration first ("(OC)",
+#    `--refine-extrinsics`), under extrinsic perturbation, alpha in {0, 0.02, 0.04, 0.1}, TRIALS seeds each (`detect run --alpha A --seed S`):
 #    mean and standard deviation of AP3D R40 at IoU 0.7, moderate.
 # Models are kept in WORK_DIR: a second run reuses them (and `--resume`s an interrupted training).
 set -euo pipefail
@@ -43,6 +43,7 @@ ap_row() {  # CASE PRED_DIR
   echo "| $1 |$cells $(jq '.detect_ms.mean | . * 10 | round / 10' "$2/metrics.json") |"
 }
 
+if [[ ${OC_ONLY:-0} != 1 ]]; then
 echo "| case | 0.7 easy | 0.7 mod. | 0.7 hard | 0.5 easy | 0.5 mod. | 0.5 hard | ms/frame |"
 echo "|---|---|---|---|---|---|---|---|"
 for lidar in top front_left front_right; do
@@ -60,15 +61,18 @@ for fusion in input feature result; do
   done
 done
 
+fi
+
 echo
 echo "| case | alpha | AP3D R40 @0.7 moderate: mean | sd | trials |"
 echo "|---|---|---|---|---|"
-# Stage 1 alone, MLOD (both stages), and MLOD with online calibration first (the thesis's "(OC)" rows:
-# `detect run --refine-extrinsics`); "oc" stands for the last.
+# Stage 1 alone and MLOD (both stages), each also with online calibration first (the thesis's "(OC)" rows:
+# `detect run --refine-extrinsics`). OC_ONLY=1 runs only the (OC) rows (models and data as above).
 for fusion in input feature result; do
-  for stage in 1 2 oc; do
-    run_args=(--stage "${stage/oc/2}")
-    [[ $stage == oc ]] && run_args+=(--refine-extrinsics)
+  for stage in 1 2 1oc 2oc; do
+    [[ ${OC_ONLY:-0} == 1 && $stage != *oc ]] && continue
+    run_args=(--stage "${stage%oc}")
+    [[ $stage == *oc ]] && run_args+=(--refine-extrinsics)
     for alpha in 0 0.02 0.04 0.1; do
       values=()
       for seed in $(seq 1 "$trials"); do
@@ -79,8 +83,9 @@ for fusion in input feature result; do
         rm -rf "$pred/label_2"
         [[ $alpha == 0 ]] && break  # no perturbation: every trial is the same
       done
-      name="$fusion stage $stage"
-      [[ $stage == oc ]] && name="$fusion MLOD (OC)"
+      name="$fusion stage ${stage%oc}"
+      [[ $stage == 2* ]] && name="$fusion MLOD"
+      [[ $stage == *oc ]] && name+=" (OC)"
       printf '%s\n' "${values[@]}" | awk -v c="$name" -v a="$alpha" \
         '{ s += $1; q += $1 * $1; n++ } END { m = s / n; v = q / n - m * m; printf "| %s | %s | %.1f | %.1f | %d |\n", c, a, m, (v > 0 ? sqrt(v) : 0), n }'
     done
