@@ -14,6 +14,7 @@
 #include "mlidar/detect/bev_grid.hpp"
 #include "mlidar/detect/online_extrinsics.hpp"
 #include "mlidar/detect/result_fusion.hpp"
+#include "mlidar/eval/calibration_metrics.hpp"
 #include "mlidar/io/frame_source.hpp"
 #include "mlidar/sim/detection_dataset.hpp"
 #include "mlidar/sim/rig.hpp"
@@ -88,8 +89,8 @@ void BM_OnlineCalibrationLyftFrame(benchmark::State& state) {
       prior.alpha = 0.04;
       const detect::RefinedExtrinsic refined = detect::refine_extrinsic_online(
           *frame.scans[ref], *source.lidars()[ref].initial_extrinsic, *frame.scans[j], sample_perturbed_extrinsic(truth, prior, rng), config);
-      trusted += refined.trusted ? 1.0 : 0.0;
-      error_deg += (truth.rotation().inverse() * refined.T_base_lidar.rotation()).angularDistance(Quat::Identity()) * 180.0 / std::numbers::pi;
+      trusted += refined.trusted() ? 1.0 : 0.0;
+      error_deg += eval::extrinsic_error(truth, refined.uncertain_extrinsic.T, std::nullopt).rotation_error_deg;
       registrations += 1.0;
     }
   }

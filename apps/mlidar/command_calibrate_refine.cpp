@@ -177,7 +177,7 @@ void write_html(const RefineOptions& options, const InitialGuess& guess, const S
   pair.T_ref_target_before = r.T_init;
   pair.before_words = "the --init guess";
   pair.T_ref_target = r.T_ref_target;
-  const bool converged = r.verdict != calib::PairVerdict::kNotConverged;
+  const bool converged = calib::is_trusted(r.verdict);
   if (converged) pair.covariance = r.covariance;
   pair.verdict_level = converged ? "ok" : "bad";
   pair.verdict = converged ? std::string(calib::to_string(r.verdict)) + ": " + options.out + " written"
@@ -212,7 +212,7 @@ int run_refine(const RefineOptions& options) {
   const calib::PairRefineResult result = calib::refine_pair(ref.points, target.points, T_init, config);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  const bool trusted = result.verdict != calib::PairVerdict::kNotConverged;
+  const bool trusted = calib::is_trusted(result.verdict);
   if (trusted) {
     io::Extrinsics extrinsics;
     extrinsics.base = guess.ref_name;

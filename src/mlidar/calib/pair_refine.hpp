@@ -24,6 +24,8 @@ namespace mlidar::calib {
 enum class PairSearchMode { kAuto, kAlways, kNever };
 enum class PairVerdict { kConverged, kSearchedAndConverged, kNotConverged };
 std::string_view to_string(PairVerdict verdict);  ///< "converged", "searched_and_converged", "not_converged"
+/// Whether a result with this verdict may be used: it passed every check (with or without the search).
+inline bool is_trusted(PairVerdict verdict) { return verdict != PairVerdict::kNotConverged; }
 
 struct PairRefineConfig {
   double min_range = 2.0;        ///< m, nearer points (the vehicle's own body) are dropped from both scans

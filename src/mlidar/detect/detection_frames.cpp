@@ -124,7 +124,7 @@ DetectionFrame DetectionDataset::read(std::size_t k, double alpha, std::uint64_t
           refine_extrinsic_online(*reference, T_base_lidar_[reference_], *scan, placement.T_base_lidar_given, *online_calibration);
       placement.refine_ran = true;
       placement.refine_verdict = refined.registration.verdict;
-      if (refined.trusted) {
+      if (refined.trusted()) {
         pose = refined.uncertain_extrinsic;
         uncertain = true;
       }

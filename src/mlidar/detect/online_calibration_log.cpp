@@ -19,7 +19,7 @@ void OnlineCalibrationLog::add(const DetectionFrame& frame) {
     if (!placement.refine_ran) continue;
     LidarRefineRecord& record = records_[j];
     ++record.registrations;
-    if (placement.refine_verdict != calib::PairVerdict::kNotConverged) {
+    if (calib::is_trusted(placement.refine_verdict)) {
       ++record.trusted;
       const eval::ExtrinsicError change = eval::extrinsic_error(placement.T_base_lidar_given, placement.T_base_lidar, std::nullopt);
       record.rotation_change_deg.push_back(change.rotation_error_deg);

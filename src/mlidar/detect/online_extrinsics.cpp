@@ -23,15 +23,14 @@ RefinedExtrinsic refine_extrinsic_online(const Scan& reference, const SE3& T_bas
                                          const SE3& T_base_lidar_given, const calib::PairRefineConfig& config) {
   RefinedExtrinsic out;
   out.registration = calib::refine_pair(reference.points, lidar.points, T_base_reference.inverse() * T_base_lidar_given, config);
-  out.trusted = out.registration.verdict != calib::PairVerdict::kNotConverged;
-  out.T_base_lidar = out.trusted ? T_base_reference * out.registration.T_ref_target : T_base_lidar_given;
+  const SE3 T_base_lidar = out.trusted() ? T_base_reference * out.registration.T_ref_target : T_base_lidar_given;
   // The registration's covariance is [t additive, r on the left of R] in the reference frame; in the base frame
   // both blocks turn by R_base_reference (t_base = R t + t_ref, R_base = Exp(R r) R R_ref_lidar): eq 6.1-6.2's
   // (rho, phi), which perturbation_as_left_covariance turns into point_covariance's left perturbation.
   Mat6 rotate = Mat6::Zero();
   rotate.topLeftCorner<3, 3>() = rotate.bottomRightCorner<3, 3>() = T_base_reference.rotation_matrix();
   const Mat6 rho_phi = rotate * out.registration.covariance * rotate.transpose();
-  out.uncertain_extrinsic = {out.T_base_lidar, perturbation_as_left_covariance(rho_phi, out.T_base_lidar)};
+  out.uncertain_extrinsic = {T_base_lidar, perturbation_as_left_covariance(rho_phi, T_base_lidar)};
   return out;
 }
 

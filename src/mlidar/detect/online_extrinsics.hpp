@@ -11,10 +11,10 @@
 namespace mlidar::detect {
 
 struct RefinedExtrinsic {
-  bool trusted = false;               ///< the registration passed refine_pair's checks
-  SE3 T_base_lidar;                   ///< the refined extrinsic when trusted, else the one given
-  UncertainPose uncertain_extrinsic;  ///< T_base_lidar with the registration's covariance as a left perturbation
+  /// The refined extrinsic when trusted, else the one given; with the registration's covariance as a left perturbation.
+  UncertainPose uncertain_extrinsic;
   calib::PairRefineResult registration;
+  bool trusted() const { return calib::is_trusted(registration.verdict); }  ///< it passed refine_pair's checks
 };
 
 /// Online calibration's registration: `calibrate refine`'s without the search, lighter (see the .cpp for the numbers).
