@@ -32,7 +32,7 @@ struct FleetOptions {
 
 /// The folder holding the `mlidar` package: the install's (PREFIX/bin/mlidar -> PREFIX/<site-packages>) first,
 /// then the build tree's.
-std::optional<fs::path> python_package_root() {
+[[maybe_unused]] std::optional<fs::path> python_package_root() {  // unused without the Python module
 #ifdef MLIDAR_PYTHON_INSTALL_DIR
   std::error_code ec;
   const fs::path executable = fs::read_symlink("/proc/self/exe", ec);

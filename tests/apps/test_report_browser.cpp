@@ -129,7 +129,9 @@ TEST(ReportBrowser, SlamAndCalibrateAutoReportsRenderOfflineWithEveryFigureDrawn
     const fs::path page = dir / run / "report.html";
     const Rendered whole = render(page, 1360, 3000, dir);
     expect_quiet(whole, page.string());
-    if (whole.image) EXPECT_GT(ink_of(*whole.image).grey_std, 5.0) << page;
+    if (whole.image) {
+      EXPECT_GT(ink_of(*whole.image).grey_std, 5.0) << page;
+    }
   }
   // slam: top and side views, the error over time, the map, lambda_min and the two estimate charts of `right`, timing.
   expect_every_figure_drawn(read_text(dir / "slam" / "report.html"), dir, 8);
@@ -162,7 +164,9 @@ TEST(ReportBrowser, EvalAndPairCalibrationPagesRenderOfflineWithEveryFigureDrawn
   for (const fs::path& page : {dir / "eval" / "report.html", dir / "planes.html"}) {
     const Rendered whole = render(page, 1360, 2400, dir);
     expect_quiet(whole, page.string());
-    if (whole.image) EXPECT_GT(ink_of(*whole.image).grey_std, 5.0) << page;
+    if (whole.image) {
+      EXPECT_GT(ink_of(*whole.image).grey_std, 5.0) << page;
+    }
   }
   // eval: the two KITTI drift charts, top and side views, the error over time; planes: before/after, top/side.
   expect_every_figure_drawn(read_text(dir / "eval" / "report.html"), dir, 5);

@@ -56,7 +56,7 @@ struct MapPoints {
 /// map.ply's points and, when it has them, their covariances' traces (a map with covariances has only finite points).
 MapPoints read_map(const fs::path& path) {
   const io::CloudFile cloud = io::read_cloud(path);
-  MapPoints map{io::to_scan(cloud.table, path.string()).points, {}};
+  MapPoints map{io::to_scan(cloud.table, path.string()).points, {}, {}};
   if (const auto covariances = io::read_point_covariances(cloud.table, path.string());
       covariances && covariances->size() == map.points.size())
     for (const io::UpperCovariance& c : *covariances) map.traces.push_back(c[0] + c[3] + c[5]);
