@@ -5,22 +5,6 @@
 
 namespace mlidar::cli {
 
-std::vector<Command> register_commands(CLI::App& app, const CliContext& context) {
-  return {register_info(app),
-          register_convert(app),
-          register_simulate(app, context),
-          register_calibrate(app, context),
-          register_odometry(app, context),
-          register_slam(app, context),
-          register_bag(app, context),
-          register_perturb(app, context),
-          register_detect(app, context),
-          register_eval(app, context),
-          register_report(app),
-          register_doctor(app),
-          register_fleet(app)};
-}
-
 CLI::Validator thread_count() {
   const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   return CLI::Range(0, 4 * cores).description("0 (all cores) to " + std::to_string(4 * cores) + " (4 x the cores)");

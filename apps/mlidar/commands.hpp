@@ -42,15 +42,10 @@ Command register_bag(CLI::App& app, const CliContext& context);
 Command register_report(CLI::App& app);
 Command register_doctor(CLI::App& app);
 Command register_perturb(CLI::App& app, const CliContext& context);
-/// `detect train|run`: MLOD on LibTorch (command_detect.cpp); without it the commands say how to get it.
-Command register_detect(CLI::App& app, const CliContext& context);
 /// `fleet run`: the Python package's Dask fleet (command_fleet.cpp).
 Command register_fleet(CLI::App& app);
 
-/// All sub-commands, in the order `mlidar --help` lists them. `context` must outlive the returned commands.
-std::vector<Command> register_commands(CLI::App& app, const CliContext& context);
-
-/// Ends each sub-command's --help with one or two real examples (command_examples.cpp); after register_commands.
+/// Ends each sub-command's --help with one or two real examples (command_examples.cpp); after the commands are added.
 void add_examples(CLI::App& app);
 
 /// Worker threads a command accepts: 0 (all cores) to 4 x the cores.

@@ -1,88 +1,33 @@
-// mlidar command-line entry point: parses the command line and maps errors to
-// the documented exit codes (0 ok, 1 untrusted/failed, 2 usage, 3 bad input,
-// 130/143 interrupted by SIGINT/SIGTERM).
-#include <pthread.h>
-#include <signal.h>
-#include <unistd.h>
-
-#include <cstdio>
-#include <cstring>
-#include <exception>
-#include <iostream>
-#include <thread>
-
-#include <CLI/CLI.hpp>
-
+// mlidar command-line entry point: every sub-command, run by cli_main.hpp (exit codes 0 ok, 1 untrusted/failed,
+// 2 usage, 3 bad input, 130/143 interrupted by SIGINT/SIGTERM). `detect train|run` are parsed here and run by
+// mlidar-detect, on LibTorch (detect_command.hpp).
+#include "apps/mlidar/cli_main.hpp"
 #include "apps/mlidar/commands.hpp"
-#include "mlidar/core/error.hpp"
-#include "mlidar/core/heap_settings.hpp"
-#include "mlidar/core/version.hpp"
-#include "mlidar/io/interrupt_cleanup.hpp"
+#include "apps/mlidar/detect_command.hpp"
 
+namespace mlidar::cli {
 namespace {
 
-/// SIGINT and SIGTERM go to one thread (blocked everywhere else, before any worker thread starts): it removes the
-/// unfinished outputs (temporary files, staging folders) and exits 128 + the signal (130, 143).
-void handle_interrupts() {
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  std::thread([signals] {
-    int signal = 0;
-    if (sigwait(&signals, &signal) != 0) return;
-    const std::size_t removed = mlidar::io::remove_unfinished_outputs();
-    std::fprintf(stderr, "mlidar: interrupted (%s); removed %zu unfinished output(s), earlier outputs are unchanged\n",
-                 signal == SIGINT ? "SIGINT" : "SIGTERM", removed);
-    _exit(128 + signal);
-  }).detach();
+/// All sub-commands, in the order `mlidar --help` lists them.
+std::vector<Command> all_commands(CLI::App& app, const CliContext& context) {
+  return {register_info(app),
+          register_convert(app),
+          register_simulate(app, context),
+          register_calibrate(app, context),
+          register_odometry(app, context),
+          register_slam(app, context),
+          register_bag(app, context),
+          register_perturb(app, context),
+          register_detect(app, detect_handoff(context)),
+          register_eval(app, context),
+          register_report(app),
+          register_doctor(app),
+          register_fleet(app)};
 }
 
 }  // namespace
+}  // namespace mlidar::cli
 
 int main(int argc, char** argv) {
-  using mlidar::ExitCode;
-  mlidar::keep_large_buffers_in_the_heap();  // core/heap_settings.hpp
-  handle_interrupts();
-  CLI::App app{"mlidar: calibration, odometry, mapping and detection for robots with several LiDARs"};
-  app.footer(
-      "Exit codes:\n"
-      "  0    ok\n"
-      "  1    the job ran but failed or its result should not be trusted (no convergence, degenerate)\n"
-      "  2    usage error (bad command line, an output that cannot be written or may not be replaced)\n"
-      "  3    bad input data or configuration file (the message names the file and field)\n"
-      "  130  interrupted (SIGINT), 143 terminated (SIGTERM): unfinished outputs removed, earlier ones unchanged");
-  app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("mlidar ") + mlidar::kVersion);
-  const mlidar::cli::CliContext context{std::vector<std::string>(argv, argv + argc)};
-  const auto commands = mlidar::cli::register_commands(app, context);
-  mlidar::cli::add_examples(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::kUsage);
-  }
-  try {
-    for (const auto& command : commands) {
-      if (command.sub->parsed()) return command.run();
-    }
-    return static_cast<int>(ExitCode::kUsage);
-  } catch (const mlidar::InputError& e) {
-    std::cerr << "mlidar: error: " << e.what() << '\n';
-    return static_cast<int>(ExitCode::kBadInput);
-  } catch (const mlidar::UsageError& e) {
-    std::cerr << "mlidar: usage error: " << e.what() << '\n';
-    return static_cast<int>(ExitCode::kUsage);
-  } catch (const mlidar::OutputError& e) {
-    std::cerr << "mlidar: cannot write output: " << e.what() << '\n';
-    return static_cast<int>(ExitCode::kUsage);
-  } catch (const std::bad_alloc&) {
-    std::cerr << "mlidar: failed: out of memory\n";
-    return static_cast<int>(ExitCode::kUntrusted);
-  } catch (const std::exception& e) {
-    std::cerr << "mlidar: failed: " << e.what() << '\n';
-    return static_cast<int>(ExitCode::kUntrusted);
-  }
+  return mlidar::cli::run_command_line(argc, argv, mlidar::cli::all_commands, mlidar::cli::add_examples);
 }

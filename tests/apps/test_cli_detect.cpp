@@ -107,6 +107,41 @@ TEST(CliDetect, BadInputExitsWithTheReason) {
   EXPECT_EQ(read_text(model / "detect.yaml"), yaml);
 }
 
+/// The bytes of a file.
+std::string file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(CliDetect, MlidarItselfDoesNotLoadLibTorch) {
+  // Every other command would pay LibTorch's start-up (about a second); detect's jobs run in mlidar-detect.
+  const std::string mlidar = file_bytes(mlidar_bin());
+  ASSERT_FALSE(mlidar.empty()) << mlidar_bin();
+  EXPECT_EQ(mlidar.find("libtorch_cpu.so"), std::string::npos);
+  EXPECT_EQ(mlidar.find("libc10.so"), std::string::npos);
+  const std::string helper = file_bytes(fs::path(mlidar_bin()).parent_path() / "mlidar-detect");
+  EXPECT_NE(helper.find("libtorch_cpu.so"), std::string::npos);
+}
+
+TEST(CliDetect, WithoutMlidarDetectBesideItSaysWhereItLooked) {
+  const fs::path dir = scratch_dir();
+  const fs::path lone = dir / "bin" / "mlidar";
+  fs::create_directories(lone.parent_path());
+  fs::copy_file(mlidar_bin(), lone);
+  // The command line is still checked (and its help shown) by mlidar alone.
+  CliResult r = run_shell(quoted(lone.string()) + " detect run --help");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--refine-extrinsics"), std::string::npos) << r.output;
+  r = run_shell(quoted(lone.string()) + " detect run --model m --dataset d --alpha 2 --out p");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--alpha"), std::string::npos) << r.output;
+  r = run_shell(quoted(lone.string()) + " detect run --model m --dataset d --out " + quoted((dir / "p").string()));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("mlidar-detect"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find((dir / "bin" / "mlidar-detect").string()), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "p"));
+}
+
 #else
 
 TEST(CliDetect, WithoutLibTorchSaysHowToGetIt) {

@@ -3,6 +3,7 @@
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -38,3 +39,13 @@ def test_the_installed_package_imports_and_reads_a_cloud_from_the_prefix(tmp_pat
     assert fleet.returncode == 3, fleet.stderr
     assert "jobs[0].recording" in fleet.stderr
     assert (prefix / os.environ["MLIDAR_PYTHON_INSTALL_DIR"] / "mlidar" / "fleet.py").exists()
+
+    # `detect run` of the installed mlidar runs the installed mlidar-detect (libexec/mlidar), not the build tree's:
+    # a missing model folder is its exit 3, naming --model.
+    if (Path(os.environ["MLIDAR_BUILD_DIR"]) / "apps" / "mlidar" / "mlidar-detect").exists():
+        assert (prefix / "libexec" / "mlidar" / "mlidar-detect").exists()
+        detect = subprocess.run([str(prefix / "bin" / "mlidar"), "detect", "run", "--model", str(tmp_path / "no_model"),
+                                 "--dataset", str(tmp_path), "--out", str(tmp_path / "pred")],
+                                capture_output=True, text=True, cwd=tmp_path)
+        assert detect.returncode == 3, detect.stderr
+        assert "--model" in detect.stderr
