@@ -34,10 +34,8 @@ struct FleetOptions {
 /// then the build tree's.
 [[maybe_unused]] std::optional<fs::path> python_package_root() {  // unused without the Python module
 #ifdef MLIDAR_PYTHON_INSTALL_DIR
-  std::error_code ec;
-  const fs::path executable = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const fs::path installed = executable.parent_path().parent_path() / MLIDAR_PYTHON_INSTALL_DIR;
+  if (const std::optional<fs::path> executable = this_executable()) {
+    const fs::path installed = executable->parent_path().parent_path() / MLIDAR_PYTHON_INSTALL_DIR;
     if (fs::exists(installed / "mlidar" / "fleet.py")) return installed;
   }
   const fs::path built = MLIDAR_PYTHON_BUILD_DIR;

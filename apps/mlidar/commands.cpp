@@ -5,6 +5,13 @@
 
 namespace mlidar::cli {
 
+std::optional<std::filesystem::path> this_executable() {
+  std::error_code ec;
+  std::filesystem::path executable = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return std::nullopt;
+  return executable;
+}
+
 CLI::Validator thread_count() {
   const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   return CLI::Range(0, 4 * cores).description("0 (all cores) to " + std::to_string(4 * cores) + " (4 x the cores)");

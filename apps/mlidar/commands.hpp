@@ -3,6 +3,7 @@
 // the app and returns its run function; main dispatches to the parsed one.
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,9 @@ Command register_fleet(CLI::App& app);
 
 /// Ends each sub-command's --help with one or two real examples (command_examples.cpp); after the commands are added.
 void add_examples(CLI::App& app);
+
+/// This process's executable (/proc/self/exe), to find what is installed beside it; nullopt when unreadable.
+std::optional<std::filesystem::path> this_executable();
 
 /// Worker threads a command accepts: 0 (all cores) to 4 x the cores.
 CLI::Validator thread_count();

@@ -24,10 +24,9 @@ constexpr const char* kDetectExecutable = "mlidar-detect";
 
 /// The executables mlidar-detect may be: beside this one (the build tree), or in libexec/mlidar of its prefix.
 std::vector<fs::path> detect_executable_candidates() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  return {self.parent_path() / kDetectExecutable, self.parent_path().parent_path() / MLIDAR_LIBEXEC_DIR / kDetectExecutable};
+  const std::optional<fs::path> self = this_executable();
+  if (!self) return {};
+  return {self->parent_path() / kDetectExecutable, self->parent_path().parent_path() / MLIDAR_LIBEXEC_DIR / kDetectExecutable};
 }
 
 [[noreturn]] void hand_over(const CliContext& context) {

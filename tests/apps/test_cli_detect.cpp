@@ -107,19 +107,13 @@ TEST(CliDetect, BadInputExitsWithTheReason) {
   EXPECT_EQ(read_text(model / "detect.yaml"), yaml);
 }
 
-/// The bytes of a file.
-std::string file_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 TEST(CliDetect, MlidarItselfDoesNotLoadLibTorch) {
   // Every other command would pay LibTorch's start-up (about a second); detect's jobs run in mlidar-detect.
-  const std::string mlidar = file_bytes(mlidar_bin());
+  const std::string mlidar = read_text(mlidar_bin());
   ASSERT_FALSE(mlidar.empty()) << mlidar_bin();
   EXPECT_EQ(mlidar.find("libtorch_cpu.so"), std::string::npos);
   EXPECT_EQ(mlidar.find("libc10.so"), std::string::npos);
-  const std::string helper = file_bytes(fs::path(mlidar_bin()).parent_path() / "mlidar-detect");
+  const std::string helper = read_text(fs::path(mlidar_bin()).parent_path() / "mlidar-detect");
   EXPECT_NE(helper.find("libtorch_cpu.so"), std::string::npos);
 }
 
