@@ -4,6 +4,7 @@
 
 #include "mlidar/io/file_bytes.hpp"
 #include "mlidar/io/pcd.hpp"
+#include "mlidar/io/point_table.hpp"
 
 namespace {
 
@@ -66,6 +67,16 @@ void BM_ParseOriginalCompressedFile(benchmark::State& state) {
   set_counters(state, points, file.size());
 }
 
+// The columns turned into the algorithms' Scan (x y z, intensity, ring, time): what every frame pays after parsing.
+void BM_PcdToScan(benchmark::State& state) {
+  const PcdCloud& cloud = real_cloud();
+  for (auto _ : state) {
+    const mlidar::Scan scan = mlidar::io::to_scan(cloud.table, "bench");
+    benchmark::DoNotOptimize(scan.points.data());
+  }
+  set_counters(state, cloud.table.num_points, 0);
+}
+
 constexpr int kAscii = static_cast<int>(PcdEncoding::kAscii);
 constexpr int kBinary = static_cast<int>(PcdEncoding::kBinary);
 constexpr int kCompressed = static_cast<int>(PcdEncoding::kBinaryCompressed);
@@ -73,5 +84,6 @@ constexpr int kCompressed = static_cast<int>(PcdEncoding::kBinaryCompressed);
 BENCHMARK(BM_ParsePcd)->Arg(kBinary)->Arg(kCompressed)->Arg(kAscii)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_EncodePcd)->Arg(kBinary)->Arg(kCompressed)->Arg(kAscii)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ParseOriginalCompressedFile)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PcdToScan)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

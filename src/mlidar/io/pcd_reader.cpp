@@ -96,21 +96,23 @@ void decode_compressed_body(std::span<const std::byte> body, const PcdHeader& he
   }
 }
 
-bool point_is_finite(const std::array<const FieldColumn*, 3>& xyz, std::size_t point) {
-  for (const FieldColumn* axis : xyz) {
-    if (axis != nullptr && !std::isfinite(axis->value(point))) return false;
-  }
-  return true;
-}
-
 // Keeps the points whose x, y and z (those present) are finite; the cloud becomes unorganised.
 void drop_non_finite_points(PointTable& table) {
-  const std::array<const FieldColumn*, 3> xyz = {table.find("x"), table.find("y"), table.find("z")};
+  std::vector<char> finite(table.num_points, 1);
+  for (const char* name : {"x", "y", "z"}) {
+    const FieldColumn* axis = table.find(name);
+    if (axis == nullptr) continue;
+    const std::vector<double> values = axis->values(table.num_points);
+    for (std::size_t i = 0; i < values.size(); ++i) finite[i] = finite[i] != 0 && std::isfinite(values[i]) ? 1 : 0;
+  }
   std::vector<std::size_t> kept;
   kept.reserve(table.num_points);
   for (std::size_t i = 0; i < table.num_points; ++i) {
-    if (point_is_finite(xyz, i)) kept.push_back(i);
+    if (finite[i] != 0) kept.push_back(i);
   }
+  table.width = static_cast<std::uint32_t>(kept.size());
+  table.height = 1;
+  if (kept.size() == table.num_points) return;  // nothing to drop: every column stays as read
   for (FieldColumn& column : table.fields) {
     const std::size_t stride = column.stride();
     for (std::size_t j = 0; j < kept.size(); ++j) {
@@ -119,8 +121,6 @@ void drop_non_finite_points(PointTable& table) {
     column.data.resize(kept.size() * stride);
   }
   table.num_points = kept.size();
-  table.width = static_cast<std::uint32_t>(kept.size());
-  table.height = 1;
 }
 
 }  // namespace

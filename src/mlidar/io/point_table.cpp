@@ -66,6 +66,11 @@ double load(const std::byte* p) {
   std::memcpy(&v, p, sizeof(T));
   return static_cast<double>(v);
 }
+
+template <typename T>
+void load_all(const std::byte* first, std::size_t stride, std::span<double> out) {
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = load<T>(first + i * stride);
+}
 }  // namespace
 
 double FieldColumn::value(std::size_t point, std::uint32_t element) const {
@@ -93,6 +98,46 @@ double FieldColumn::value(std::size_t point, std::uint32_t element) const {
       return load<double>(p);
   }
   return 0.0;
+}
+
+std::vector<double> FieldColumn::values(std::size_t num_points, std::uint32_t element) const {
+  std::vector<double> out(num_points);
+  if (num_points == 0) return out;
+  const std::byte* first = data.data() + element * scalar_size(type);
+  const std::size_t step = stride();
+  switch (type) {
+    case ScalarType::kI8:
+      load_all<std::int8_t>(first, step, out);
+      break;
+    case ScalarType::kU8:
+      load_all<std::uint8_t>(first, step, out);
+      break;
+    case ScalarType::kI16:
+      load_all<std::int16_t>(first, step, out);
+      break;
+    case ScalarType::kU16:
+      load_all<std::uint16_t>(first, step, out);
+      break;
+    case ScalarType::kI32:
+      load_all<std::int32_t>(first, step, out);
+      break;
+    case ScalarType::kU32:
+      load_all<std::uint32_t>(first, step, out);
+      break;
+    case ScalarType::kI64:
+      load_all<std::int64_t>(first, step, out);
+      break;
+    case ScalarType::kU64:
+      load_all<std::uint64_t>(first, step, out);
+      break;
+    case ScalarType::kF32:
+      load_all<float>(first, step, out);
+      break;
+    case ScalarType::kF64:
+      load_all<double>(first, step, out);
+      break;
+  }
+  return out;
 }
 
 const FieldColumn* PointTable::find(const std::string& name) const {
@@ -185,16 +230,24 @@ Scan to_scan(const PointTable& table, const std::string& source, const ScanOptio
   const FieldColumn* ft = options.read_time ? find_time_field(table) : nullptr;
   const double scale = ft != nullptr ? unit_scale(time_unit_of(*ft, options.time_unit, source)) : 1.0;
 
+  const std::size_t n = table.num_points;
+  const std::vector<double> xs = fx->values(n), ys = fy->values(n), zs = fz->values(n);
+  const std::vector<double> intensities = fi != nullptr ? fi->values(n) : std::vector<double>{};
+  const std::vector<double> rings = fr != nullptr ? fr->values(n) : std::vector<double>{};
+  const std::vector<double> times = ft != nullptr ? ft->values(n) : std::vector<double>{};
   Scan scan;
-  scan.points.reserve(table.num_points);
+  scan.points.reserve(n);
+  scan.intensity.reserve(intensities.size());
+  scan.ring.reserve(rings.size());
   std::vector<double> raw_time;
-  for (std::size_t i = 0; i < table.num_points; ++i) {
-    const Eigen::Vector3d p(fx->value(i), fy->value(i), fz->value(i));
+  raw_time.reserve(times.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d p(xs[i], ys[i], zs[i]);
     if (!p.allFinite() && options.drop_nan) continue;
     scan.points.push_back(p.cast<float>());
-    if (fi != nullptr) scan.intensity.push_back(static_cast<float>(fi->value(i)));
-    if (fr != nullptr) scan.ring.push_back(static_cast<std::uint16_t>(fr->value(i)));
-    if (ft != nullptr) raw_time.push_back(ft->value(i));
+    if (fi != nullptr) scan.intensity.push_back(static_cast<float>(intensities[i]));
+    if (fr != nullptr) scan.ring.push_back(static_cast<std::uint16_t>(rings[i]));
+    if (ft != nullptr) raw_time.push_back(times[i]);
   }
   if (!raw_time.empty()) {
     const auto [lo, hi] = std::minmax_element(raw_time.begin(), raw_time.end());

@@ -57,6 +57,14 @@ void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3
   const double h_step = 2.0 * std::numbers::pi / image.cols;
   const double sin_h = std::sin(h_step);
   const double cos_h = std::cos(h_step);
+  // The vertical step between row r and r + 1, once per row pair instead of once per pixel pair.
+  std::vector<double> sin_up(static_cast<std::size_t>(std::max(image.rows - 1, 0)));
+  std::vector<double> cos_up(sin_up.size());
+  for (std::size_t r = 0; r < sin_up.size(); ++r) {
+    const double v_step = std::abs(sorted_angles_deg[r + 1] - sorted_angles_deg[r]) * kRadians;
+    sin_up[r] = std::sin(v_step);
+    cos_up[r] = std::cos(v_step);
+  }
   out.queue.resize(pixels);
   out.clusters = 0;
   for (std::size_t seed = 0; seed < pixels; ++seed) {
@@ -83,10 +91,9 @@ void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3
         double sin_step = sin_h;
         double cos_step = cos_h;
         if (nrow != row) {
-          const double v_step =
-              std::abs(sorted_angles_deg[static_cast<std::size_t>(nrow)] - sorted_angles_deg[static_cast<std::size_t>(row)]) * kRadians;
-          sin_step = std::sin(v_step);
-          cos_step = std::cos(v_step);
+          const auto lower = static_cast<std::size_t>(std::min(nrow, row));
+          sin_step = sin_up[lower];
+          cos_step = cos_up[lower];
         }
         if (!same_object(image.range[p], image.range[q], sin_step, cos_step, tan_threshold)) continue;
         out.label[q] = id;
