@@ -18,7 +18,6 @@
 namespace mlidar::test {
 namespace {
 
-void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 /// Rewrites the t field of a scan: t' = scale * t + shift.
 void retime(const fs::path& scan, double scale, double shift) {

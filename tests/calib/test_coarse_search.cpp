@@ -14,9 +14,9 @@ namespace mlidar::calib {
 namespace {
 
 // Target 2.3 m ahead, 0.95 m left, 1.3 m below the reference, yawed 45 deg, tilted 1 deg.
-const SE3 kTruth(so3_exp(Vec3(0.0, 0.0, deg_to_rad(45.0))) * so3_exp(Vec3(deg_to_rad(1.0), 0.0, 0.0)), Vec3(2.3, 0.95, -1.3));
+const SE3 kT_ref_target(so3_exp(Vec3(0.0, 0.0, deg_to_rad(45.0))) * so3_exp(Vec3(deg_to_rad(1.0), 0.0, 0.0)), Vec3(2.3, 0.95, -1.3));
 
-/// Ground z = -1.8 in the reference frame and two walls, seen by the reference and by the target at kTruth.
+/// Ground z = -1.8 in the reference frame and two walls, seen by the reference and by the target at kT_ref_target.
 std::pair<std::vector<Eigen::Vector3f>, std::vector<Eigen::Vector3f>> scene() {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-15.0, 15.0);
@@ -25,7 +25,7 @@ std::pair<std::vector<Eigen::Vector3f>, std::vector<Eigen::Vector3f>> scene() {
     for (const Vec3& p :
          {Vec3(u(rng), u(rng), -1.8), Vec3(9.0, u(rng), -1.8 + 0.1 * (u(rng) + 15.0)), Vec3(u(rng), -7.0, -1.8 + 0.1 * (u(rng) + 15.0))}) {
       ref.push_back(p.cast<float>());
-      target.push_back((kTruth.inverse() * p).cast<float>());
+      target.push_back((kT_ref_target.inverse() * p).cast<float>());
     }
   }
   return {ref, target};
@@ -34,8 +34,8 @@ std::pair<std::vector<Eigen::Vector3f>, std::vector<Eigen::Vector3f>> scene() {
 double nearest_translation_m(const std::vector<StartPose>& starts, double max_rotation_deg) {
   double best = 1e9;
   for (const StartPose& s : starts)
-    if (rad_to_deg(s.T_ref_target.rotation().angularDistance(kTruth.rotation())) <= max_rotation_deg)
-      best = std::min(best, (s.T_ref_target.translation() - kTruth.translation()).norm());
+    if (rad_to_deg(s.T_ref_target.rotation().angularDistance(kT_ref_target.rotation())) <= max_rotation_deg)
+      best = std::min(best, (s.T_ref_target.translation() - kT_ref_target.translation()).norm());
   return best;
 }
 
@@ -57,8 +57,8 @@ TEST(CoarseSearch, GridAboutAFarGuessHoldsAStartNearTheTruth) {
   EXPECT_LT(nearest_translation_m(with, 8.6), 0.71);
   // Its height is the truth's: the ground sets it.
   for (const StartPose& s : with)
-    if (rad_to_deg(s.T_ref_target.rotation().angularDistance(kTruth.rotation())) <= 8.6) {
-      EXPECT_NEAR(s.T_ref_target.translation().z(), kTruth.translation().z(), 0.1) << s.label;
+    if (rad_to_deg(s.T_ref_target.rotation().angularDistance(kT_ref_target.rotation())) <= 8.6) {
+      EXPECT_NEAR(s.T_ref_target.translation().z(), kT_ref_target.translation().z(), 0.1) << s.label;
     }
 }
 

@@ -14,7 +14,7 @@
 namespace mlidar::calib {
 namespace {
 
-const SE3 kTruth(so3_exp(Vec3(0.1, -0.2, 0.3)), Vec3(0.5, -0.2, 0.1));
+const SE3 kTrueExtrinsic(so3_exp(Vec3(0.1, -0.2, 0.3)), Vec3(0.5, -0.2, 0.1));
 
 /// A random orthonormal 6x6 basis (seeded): information = V diag(eigenvalues) V^T.
 Mat6 random_basis(std::uint64_t seed) {
@@ -50,16 +50,16 @@ TEST(ConvergenceMonitor, AcceptsJustAboveAndRejectsJustBelowLambdaCalib) {
 }
 
 TEST(ConvergenceMonitor, AConstrainedWindowThatHasNotSettledIsNotAccepted) {
-  ConvergenceMonitor monitor({kTruth});
+  ConvergenceMonitor monitor({kTrueExtrinsic});
   const Mat6 information = information_with_min(100.0, 4);
-  const WindowVerdict moving = monitor.add_window(0, kTruth, information, 1e-3, false);
+  const WindowVerdict moving = monitor.add_window(0, kTrueExtrinsic, information, 1e-3, false);
   EXPECT_TRUE(moving.constrained);
   EXPECT_FALSE(moving.accepted);
   EXPECT_TRUE(monitor.lidar(0).accepted.empty());
-  const WindowVerdict settled = monitor.add_window(0, kTruth, information, 1e-3, true);
+  const WindowVerdict settled = monitor.add_window(0, kTrueExtrinsic, information, 1e-3, true);
   EXPECT_TRUE(settled.constrained && settled.accepted);
   EXPECT_EQ(monitor.lidar(0).accepted.size(), 1u);
-  EXPECT_FALSE(monitor.add_window(0, kTruth, information_with_min(40.0, 5), 1e-3, true).constrained);
+  EXPECT_FALSE(monitor.add_window(0, kTrueExtrinsic, information_with_min(40.0, 5), 1e-3, true).constrained);
 }
 
 TEST(RobustInliers, DropsTheFarEstimatesAndKeepsAgreeingOnes) {
@@ -85,32 +85,32 @@ TEST(ConvergenceMonitor, OutlyingAcceptedEstimatesAreLeftOutOfTheMean) {
   const auto run = [&](double outlier_mads) {
     ConvergenceConfig config;
     config.outlier_mads = outlier_mads;
-    ConvergenceMonitor monitor({kTruth}, config);
+    ConvergenceMonitor monitor({kTrueExtrinsic}, config);
     rng.seed(11);
     for (int i = 0; i < 25; ++i) {
       const Vec3 t_error = i < 19 ? Vec3(noise(rng), noise(rng), noise(rng)) : Vec3(0.0, 0.1, 0.0);  // 6 windows 10 cm off in y
-      monitor.add_window(0, SE3(kTruth.rotation(), kTruth.translation() + t_error), information_with_min(100.0, 40 + i));
+      monitor.add_window(0, SE3(kTrueExtrinsic.rotation(), kTrueExtrinsic.translation() + t_error), information_with_min(100.0, 40 + i));
     }
     EXPECT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
     return monitor.lidar(0);
   };
   const LidarCalibrationState plain = run(0.0);
   EXPECT_EQ(plain.outliers, 0u);
-  EXPECT_GT((plain.T_base_lidar.translation() - kTruth.translation()).norm(), 0.02);  // 6 / 25 of 10 cm
+  EXPECT_GT((plain.T_base_lidar.translation() - kTrueExtrinsic.translation()).norm(), 0.02);  // 6 / 25 of 10 cm
   const LidarCalibrationState robust = run(3.0);
   EXPECT_EQ(robust.outliers, 6u);
-  EXPECT_LT((robust.T_base_lidar.translation() - kTruth.translation()).norm(), 0.004);
+  EXPECT_LT((robust.T_base_lidar.translation() - kTrueExtrinsic.translation()).norm(), 0.004);
 }
 
 TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
-  ConvergenceMonitor monitor({kTruth});
+  ConvergenceMonitor monitor({kTrueExtrinsic});
   std::mt19937_64 rng(3);
   std::normal_distribution<double> n(0.0, 0.01);
   int accepted = 0;
   std::vector<SE3> good_estimates;  // the constructed inputs that must be accepted, for the expected mean below
   for (int window = 0; accepted < 25; ++window) {
     const bool good = window % 3 != 1;  // every third window is degenerate
-    const SE3 estimate(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTruth.rotation(), kTruth.translation() + Vec3(n(rng), n(rng), n(rng)));
+    const SE3 estimate(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTrueExtrinsic.rotation(), kTrueExtrinsic.translation() + Vec3(n(rng), n(rng), n(rng)));
     if (good) good_estimates.push_back(estimate);
     const WindowVerdict v = monitor.add_window(0, estimate, information_with_min(good ? 90.0 : 40.0, 10 + window));
     EXPECT_EQ(v.accepted, good);
@@ -131,7 +131,7 @@ TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   Vec3 expected_t = Vec3::Zero();
   for (const SE3& T : good_estimates) expected_t += T.translation();
   expected_t /= count;
-  Quat expected_R = kTruth.rotation();
+  Quat expected_R = kTrueExtrinsic.rotation();
   for (int iteration = 0; iteration < 100; ++iteration) {
     Vec3 step = Vec3::Zero();
     for (const SE3& T : good_estimates) step += so3_log(T.rotation() * expected_R.conjugate());
@@ -176,11 +176,11 @@ TEST(ConvergenceMonitor, ConvergesAfterExactlyLCalibAcceptedWindows) {
   EXPECT_GT(monitor.lidar(0).covariance.diagonal().minCoeff(), 0.25 * 0.01 * 0.01 / 25);
 }
 
-/// A monitor that needs 4 accepted windows, fed 4 identical ones (estimate kTruth, residual variance 1e-3).
+/// A monitor that needs 4 accepted windows, fed 4 identical ones (estimate kTrueExtrinsic, residual variance 1e-3).
 ConvergenceMonitor converged_on_identical_windows(ConvergenceConfig config, const Mat6& information) {
   config.accepted_needed = 4;
-  ConvergenceMonitor monitor({kTruth}, config);
-  for (int window = 0; window < 4; ++window) monitor.add_window(0, kTruth, information, 1e-3);
+  ConvergenceMonitor monitor({kTrueExtrinsic}, config);
+  for (int window = 0; window < 4; ++window) monitor.add_window(0, kTrueExtrinsic, information, 1e-3);
   return monitor;
 }
 
@@ -196,7 +196,7 @@ TEST(ConvergenceMonitor, WindowCovariancesEnterXiCalibWhenTheResidualVarianceIsG
   const Mat6 basis = random_basis(2);
   const Vec6 inverse_eigenvalues = (Vec6() << 1.0 / 100, 1.0 / 200, 1.0 / 300, 1.0 / 400, 1.0 / 500, 1.0 / 600).finished();
   const Mat6 inverse_information = basis * inverse_eigenvalues.asDiagonal() * basis.transpose();
-  const Vec3 t = kTruth.translation();
+  const Vec3 t = kTrueExtrinsic.translation();
   Mat3 t_cross;
   t_cross << 0.0, -t.z(), t.y(),  //
       t.z(), 0.0, -t.x(),         //
@@ -204,11 +204,11 @@ TEST(ConvergenceMonitor, WindowCovariancesEnterXiCalibWhenTheResidualVarianceIsG
   Mat6 left_to_local = Mat6::Zero();
   left_to_local.topLeftCorner<3, 3>() = Mat3::Identity();
   left_to_local.topRightCorner<3, 3>() = -t_cross;
-  left_to_local.bottomRightCorner<3, 3>() = kTruth.rotation().toRotationMatrix().transpose();
+  left_to_local.bottomRightCorner<3, 3>() = kTrueExtrinsic.rotation().toRotationMatrix().transpose();
   const Mat6 expected = left_to_local * (1e-3 * inverse_information) * left_to_local.transpose();
   EXPECT_TRUE(monitor.lidar(0).covariance.isApprox(expected, 1e-9));
   EXPECT_DOUBLE_EQ(monitor.lidar(0).covariance_parts.autocorrelation_time, 4.0);  // the floor 5 clamped to n
-  EXPECT_THROW(ConvergenceMonitor({kTruth}, ConvergenceConfig{.min_autocorrelation_time = 0.5}), std::invalid_argument);
+  EXPECT_THROW(ConvergenceMonitor({kTrueExtrinsic}, ConvergenceConfig{.min_autocorrelation_time = 0.5}), std::invalid_argument);
 }
 
 TEST(ConvergenceMonitor, SharedErrorFloorIsAddedPerAxis) {
@@ -231,20 +231,20 @@ TEST(ExtrinsicMean, SymmetricSamplesGiveTheCentreAndTheAnalyticCovariance) {
   // covariance sum_j 2 [e_j; d_j][e_j; d_j]^T / (25 - 1).
   std::mt19937_64 rng(4);
   std::normal_distribution<double> n(0.0, 0.05);
-  std::vector<SE3> samples{kTruth};
+  std::vector<SE3> samples{kTrueExtrinsic};
   Mat6 expected = Mat6::Zero();
   for (int j = 0; j < 12; ++j) {
     Vec6 x;
     for (int i = 0; i < 6; ++i) x(i) = n(rng);
     for (const double s : {1.0, -1.0}) {
-      samples.emplace_back(so3_exp(s * x.tail<3>()) * kTruth.rotation(), kTruth.translation() + s * x.head<3>());
+      samples.emplace_back(so3_exp(s * x.tail<3>()) * kTrueExtrinsic.rotation(), kTrueExtrinsic.translation() + s * x.head<3>());
     }
     expected += 2.0 * x * x.transpose();
   }
   expected /= 24.0;
   const ExtrinsicMean mean = extrinsic_mean(samples);
-  EXPECT_LT(so3_log(mean.mean.rotation() * kTruth.rotation().conjugate()).norm(), 1e-12);
-  EXPECT_LT((mean.mean.translation() - kTruth.translation()).norm(), 1e-15);
+  EXPECT_LT(so3_log(mean.mean.rotation() * kTrueExtrinsic.rotation().conjugate()).norm(), 1e-12);
+  EXPECT_LT((mean.mean.translation() - kTrueExtrinsic.translation()).norm(), 1e-15);
   EXPECT_TRUE(mean.covariance.isApprox(expected, 1e-10));
 }
 
@@ -254,7 +254,7 @@ TEST(ExtrinsicMean, RandomSamplesSatisfyTheKarcherConditionAndMatchTheChordalMea
   std::vector<SE3> samples;
   std::vector<Quat> rotations;
   for (int i = 0; i < 25; ++i) {
-    samples.emplace_back(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTruth.rotation(), Vec3(n(rng), n(rng), n(rng)));
+    samples.emplace_back(so3_exp(Vec3(n(rng), n(rng), n(rng))) * kTrueExtrinsic.rotation(), Vec3(n(rng), n(rng), n(rng)));
     rotations.push_back(samples.back().rotation());
   }
   const ExtrinsicMean mean = extrinsic_mean(samples);
@@ -308,7 +308,7 @@ TEST(ConvergenceMonitor, WeakDirectionsOfTheLastWindowAreReportedPerLidar) {
   ConvergenceMonitor monitor({SE3(), SE3()});
   Vec6 planar;
   planar << 500, 500, 2.0, 500, 500, 500;
-  monitor.add_window(1, kTruth, planar.asDiagonal());
+  monitor.add_window(1, kTrueExtrinsic, planar.asDiagonal());
   ASSERT_EQ(monitor.lidar(1).weak.size(), 1u);
   EXPECT_EQ(monitor.lidar(1).weak[0].description, "translation z");
   EXPECT_TRUE(monitor.lidar(0).weak.empty());
@@ -319,23 +319,23 @@ TEST(ConvergenceMonitor, RestartReturnsToCalibratingWithAnEmptySet) {
   ConvergenceConfig config;
   config.accepted_needed = 3;
   ConvergenceMonitor monitor({SE3()}, config);
-  for (int i = 0; i < 3; ++i) monitor.add_window(0, kTruth, information_with_min(100.0, 20 + i));
+  for (int i = 0; i < 3; ++i) monitor.add_window(0, kTrueExtrinsic, information_with_min(100.0, 20 + i));
   ASSERT_EQ(monitor.lidar(0).mode, CalibrationMode::converged);
   monitor.restart(0);
   EXPECT_EQ(monitor.lidar(0).mode, CalibrationMode::calibrating);
   EXPECT_TRUE(monitor.lidar(0).accepted.empty());
   EXPECT_EQ(monitor.lidar(0).restarts, 1u);
-  EXPECT_LT(so3_log(monitor.lidar(0).T_base_lidar.rotation() * kTruth.rotation().conjugate()).norm(), 1e-12);
-  EXPECT_TRUE(monitor.add_window(0, kTruth, information_with_min(100.0, 30)).accepted);
+  EXPECT_LT(so3_log(monitor.lidar(0).T_base_lidar.rotation() * kTrueExtrinsic.rotation().conjugate()).norm(), 1e-12);
+  EXPECT_TRUE(monitor.add_window(0, kTrueExtrinsic, information_with_min(100.0, 30)).accepted);
 }
 
 TEST(ConvergenceMonitor, NonFiniteInputIsNeverAccepted) {
   ConvergenceMonitor monitor({SE3()});
   Mat6 info = information_with_min(100.0, 40);
   info(2, 3) = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(monitor.add_window(0, kTruth, info).accepted);
+  EXPECT_FALSE(monitor.add_window(0, kTrueExtrinsic, info).accepted);
   EXPECT_THROW(ConvergenceMonitor({}), std::invalid_argument);
-  EXPECT_THROW(monitor.add_window(3, kTruth, Mat6::Identity()), std::out_of_range);
+  EXPECT_THROW(monitor.add_window(3, kTrueExtrinsic, Mat6::Identity()), std::out_of_range);
 }
 
 }  // namespace

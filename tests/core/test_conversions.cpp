@@ -15,18 +15,17 @@ namespace {
 
 using test::rotation_error_rad;
 
-constexpr double kPi = std::numbers::pi;
 
 TEST(Conversions, DegreesAndRadians) {
-  EXPECT_DOUBLE_EQ(deg_to_rad(180.0), kPi);
-  EXPECT_DOUBLE_EQ(rad_to_deg(kPi / 2.0), 90.0);
+  EXPECT_DOUBLE_EQ(deg_to_rad(180.0), std::numbers::pi);
+  EXPECT_DOUBLE_EQ(rad_to_deg(std::numbers::pi / 2.0), 90.0);
   EXPECT_DOUBLE_EQ(rad_to_deg(deg_to_rad(37.5)), 37.5);
 }
 
 TEST(Conversions, WxyzRoundTripAndSign) {
   std::mt19937 rng(51);
   for (int i = 0; i < 200; ++i) {
-    const Quat q = so3_exp(test::random_rotation_vector(rng, 0.0, kPi));
+    const Quat q = so3_exp(test::random_rotation_vector(rng, 0.0, std::numbers::pi));
     const Vec4 wxyz = quat_to_wxyz(q);
     EXPECT_GE(wxyz(0), 0.0);
     EXPECT_NEAR(wxyz.norm(), 1.0, 1e-15);
@@ -47,7 +46,7 @@ TEST(Conversions, WxyzRejectsNonRotations) {
 TEST(Conversions, RotationVectorRoundTrip) {
   std::mt19937 rng(52);
   for (int i = 0; i < 200; ++i) {
-    const Vec3 phi = test::random_rotation_vector(rng, 0.0, kPi - 1e-6);
+    const Vec3 phi = test::random_rotation_vector(rng, 0.0, std::numbers::pi - 1e-6);
     EXPECT_LT((rotation_vector_from_quat(quat_from_rotation_vector(phi)) - phi).norm(), 1e-12);
   }
 }
@@ -55,7 +54,7 @@ TEST(Conversions, RotationVectorRoundTrip) {
 // Oracle: R = Rz(yaw) Ry(pitch) Rx(roll) composed from so3_exp, and single-axis cases.
 TEST(Conversions, RpyFollowsTheThesisConvention) {
   std::mt19937 rng(53);
-  std::uniform_real_distribution<double> angle(-kPi, kPi);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
   for (int i = 0; i < 200; ++i) {
     const Vec3 rpy(angle(rng), angle(rng) / 2.0, angle(rng));
     const Quat expected = so3_exp(rpy.z() * Vec3::UnitZ()) * so3_exp(rpy.y() * Vec3::UnitY()) * so3_exp(rpy.x() * Vec3::UnitX());
@@ -69,12 +68,12 @@ TEST(Conversions, RpyFollowsTheThesisConvention) {
 
 TEST(Conversions, RpyRoundTripAwayFromGimbalLock) {
   std::mt19937 rng(54);
-  std::uniform_real_distribution<double> angle(-kPi + 1e-9, kPi - 1e-9);
-  std::uniform_real_distribution<double> pitch(-kPi / 2.0 + 1e-3, kPi / 2.0 - 1e-3);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi + 1e-9, std::numbers::pi - 1e-9);
+  std::uniform_real_distribution<double> pitch(-std::numbers::pi / 2.0 + 1e-3, std::numbers::pi / 2.0 - 1e-3);
   for (int i = 0; i < 500; ++i) {
     const Vec3 rpy(angle(rng), pitch(rng), angle(rng));
     EXPECT_LT((rpy_from_quat(quat_from_rpy(rpy)) - rpy).norm(), 1e-10) << rpy.transpose();
-    const Vec3 rpy_deg = rpy * (180.0 / kPi);
+    const Vec3 rpy_deg = rpy * (180.0 / std::numbers::pi);
     EXPECT_LT((rpy_deg_from_quat(quat_from_rpy_deg(rpy_deg)) - rpy_deg).norm(), 1e-8);
   }
 }
@@ -87,12 +86,12 @@ TEST(Conversions, RpyNearGimbalLockRebuildsTheRotation) {
   for (const double side : {1.0, -1.0}) {
     for (const double gap : {1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 1e-13, 0.0}) {
       for (int i = 0; i < 20; ++i) {
-        const Vec3 rpy(angle(rng), side * (kPi / 2.0 - gap), angle(rng));
+        const Vec3 rpy(angle(rng), side * (std::numbers::pi / 2.0 - gap), angle(rng));
         const Quat q = quat_from_rpy(rpy);
         const Vec3 back = rpy_from_quat(q);
         EXPECT_LT(rotation_error_rad(quat_from_rpy(back), q), 1e-13) << "gap " << gap;
         EXPECT_NEAR(back.y(), rpy.y(), 1e-13) << "gap " << gap;
-        EXPECT_LE(std::abs(back.y()), kPi / 2.0);
+        EXPECT_LE(std::abs(back.y()), std::numbers::pi / 2.0);
         if (gap >= 1e-3) {
           EXPECT_LT((back - rpy).norm(), 1e-11) << "gap " << gap;
         }
@@ -100,7 +99,7 @@ TEST(Conversions, RpyNearGimbalLockRebuildsTheRotation) {
     }
   }
   // Exactly at the lock roll is 0 and yaw carries the whole angle.
-  const Vec3 locked = rpy_from_quat(quat_from_rpy(Vec3(0.4, kPi / 2.0, 0.1)));
+  const Vec3 locked = rpy_from_quat(quat_from_rpy(Vec3(0.4, std::numbers::pi / 2.0, 0.1)));
   EXPECT_EQ(locked.x(), 0.0);
   EXPECT_NEAR(locked.z(), 0.1 - 0.4, 1e-14);
 }

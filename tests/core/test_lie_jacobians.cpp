@@ -15,11 +15,10 @@ namespace {
 using test::numeric_jacobian;
 using test::random_unit_vector;
 
-constexpr double kPi = std::numbers::pi;
 
 // Angles that exercise zero, the Taylor branches (< 1e-2), both sides of the
 // switch, ordinary angles and the neighbourhood of pi.
-const std::vector<double> kAngles = {0.0, 1e-12, 1e-8, 1e-5, 1e-3, 0.0099, 0.0101, 0.3, 1.0, 2.0, 3.0, kPi - 1e-6};
+const std::vector<double> kAngles = {0.0, 1e-12, 1e-8, 1e-5, 1e-3, 0.0099, 0.0101, 0.3, 1.0, 2.0, 3.0, std::numbers::pi - 1e-6};
 
 // J_l: Log(Exp(phi + d) Exp(phi)^-1) ~= J_l d;  J_r: Log(Exp(phi)^-1 Exp(phi + d)) ~= J_r d.
 Mat3 numeric_so3_left(const Vec3& phi) {

@@ -10,7 +10,7 @@
 namespace mlidar::eval {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
 const SE3 kTruth(so3_exp(Vec3(0.1, -0.4, 2.0)), Vec3(0.5, -0.2, 1.1));
 
 TEST(ExtrinsicError, KnownRotationAndTranslationErrors) {
@@ -18,8 +18,8 @@ TEST(ExtrinsicError, KnownRotationAndTranslationErrors) {
     const Vec3 axis = Vec3(1.0, 2.0, -0.5).normalized();
     const Vec3 shift(0.03, -0.04, 0.0);  // 5 cm
     // Perturb on either side: the geodesic angle is the same.
-    const SE3 left(so3_exp(angle_deg * kDeg * axis) * kTruth.rotation(), kTruth.translation() + shift);
-    const SE3 right(kTruth.rotation() * so3_exp(angle_deg * kDeg * axis), kTruth.translation() - shift);
+    const SE3 left(so3_exp(angle_deg * kRadiansPerDegree * axis) * kTruth.rotation(), kTruth.translation() + shift);
+    const SE3 right(kTruth.rotation() * so3_exp(angle_deg * kRadiansPerDegree * axis), kTruth.translation() - shift);
     for (const SE3& estimate : {left, right}) {
       const ExtrinsicError error = extrinsic_error(kTruth, estimate, std::nullopt);
       EXPECT_NEAR(error.rotation_error_deg, angle_deg, 1e-9);
@@ -56,7 +56,7 @@ TEST(EvaluateCalibration, PerLidarInGroundTruthOrderAndMissingLidar) {
   io::Extrinsics gt;
   gt.lidars = {{"top", kTruth, std::nullopt}, {"left", SE3(), std::nullopt}};
   io::Extrinsics est;
-  est.lidars = {{"left", SE3(so3_exp(Vec3(0, 2.0 * kDeg, 0)), Vec3::Zero()), std::nullopt}, {"top", kTruth, std::nullopt}};
+  est.lidars = {{"left", SE3(so3_exp(Vec3(0, 2.0 * kRadiansPerDegree, 0)), Vec3::Zero()), std::nullopt}, {"top", kTruth, std::nullopt}};
   const auto errors = evaluate_calibration(gt, est, "est.yaml");
   ASSERT_EQ(errors.size(), 2U);
   EXPECT_EQ(errors[0].name, "top");

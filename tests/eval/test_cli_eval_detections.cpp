@@ -15,10 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_text(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream(path) << text;
-}
 
 const std::string kCarAt10 = "car 0 0 -10 -1 -1 -1 -1 1.5 1.8 4.4 10 0 -1.7 0.3";
 const std::string kCarAt15 = "Car 0 0 -10 -1 -1 -1 -1 1.5 1.8 4.4 0 15 -1.7 1.2";

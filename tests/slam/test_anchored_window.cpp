@@ -16,7 +16,7 @@
 namespace mlidar::slam {
 namespace {
 
-constexpr double kHuberOff = 1e6;  // weights 1
+using test::kHuberOff;
 
 struct AnchoredWindow {
   WindowState state;

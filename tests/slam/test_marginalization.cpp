@@ -13,7 +13,7 @@
 namespace mlidar::slam {
 namespace {
 
-constexpr double kHuberOff = 1e6;  // every residual inside the Huber scale: weights 1
+using test::kHuberOff;
 
 /// Three poses (all variables), two LiDARs (the auxiliary one a variable), a few
 /// features per frame, the state perturbed from the truth (non-zero residuals),

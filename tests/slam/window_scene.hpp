@@ -87,6 +87,9 @@ inline void schur_without_first_pose(const Eigen::MatrixXd& H, const Eigen::Vect
   schur_g = g.tail(n - 6) - H_rm * H_mm_inv * g.head(6);
 }
 
+/// A Huber scale no residual reaches: every weight 1.
+inline constexpr double kHuberOff = 1e6;
+
 /// Tangent distance |Log(a b^-1)|.
 inline double distance(const SE3& a, const SE3& b) { return (a * b.inverse()).log().norm(); }
 
