@@ -79,10 +79,11 @@ int run_train(const DetectTrainOptions& options) {
   request.resume = options.resume;
   request.max_steps = options.max_steps;
   // --resume without --config goes on with the folder's own configuration.
-  const fs::path config = !options.config.empty() ? fs::path(options.config)
-                          : options.resume || options.stage == 2 ? fs::path(options.out) / "detect.yaml"
-                                                                  : fs::path();
-  if (!config.empty()) request.config = detect::read_detect_config(config);
+  if (!options.config.empty()) {
+    request.config = detect::read_detect_config(options.config);
+  } else if (options.resume || options.stage == 2) {
+    request.config = detect::read_model_detect_config(fs::path(options.out) / "detect.yaml");
+  }
   if (options.threads > 0) request.config.threads = options.threads;
   detect::train_detector(request, training_progress_bar());
   const detect::ModelFolder model = detect::read_model_folder(options.out);

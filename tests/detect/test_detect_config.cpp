@@ -134,6 +134,83 @@ TEST(ModelFolder, ReadsWhatItWroteAndRefusesAnotherConfigurationOrVersion) {
   }
 }
 
+// The detect.yaml and fingerprint of a model trained (small protocol run, input fusion) by the version before
+// stage1.uncertain_share existed: such folders must still load, with stage 1 known to have seen clean frames only.
+constexpr const char* kYamlBeforeStage1Perturbation = R"(class: car
+seed: 1
+threads: 2
+validation_share: 0.1
+grid:
+  x_min: -51.2
+  x_max: 51.2
+  y_min: -51.2
+  y_max: 51.2
+  z_min: -3
+  z_max: 3
+  cell: 0.4
+anchors:
+  length: 3.9
+  width: 1.6
+  height: 1.56
+  bottom_z: 0
+  stride: 2
+  positive_iou: 0.6
+  negative_iou: 0.45
+network:
+  channels: 32
+stage1:
+  epochs: 8
+  learning_rate: 0.002
+  weight_decay: 1e-04
+  focal_alpha: 0.25
+  focal_gamma: 2
+  regression_weight: 2
+  direction_weight: 0.2
+  checkpoint_every: 200
+augmentation:
+  share: 0.3
+  flip_y: true
+  translation_m: [0.5, 0.5, 0.3]
+  rotation_deg: 5
+  scale: [0.95, 1.05]
+inference:
+  score_threshold: 0.3
+  pre_nms: 200
+  nms_iou: 0.2
+  max_detections: 100
+stage2:
+  epochs: 3
+  learning_rate: 0.001
+  margin_m: 2
+  points: 128
+  positive_iou: 0.6
+  negative_iou: 0.45
+  eta: 2
+  lambda: 0.005
+  uncertain_share: 0.6
+  alphas: [0.02, 0.04, 0.06, 0.08, 0.1]
+  proposals: 32
+  jittered_truths: 4
+)";
+
+TEST(ModelFolder, AFolderWrittenBeforeStageOnePerturbationStillLoads) {
+  const fs::path folder = test::scratch_dir();
+  test::write_text(folder / "detect.yaml", kYamlBeforeStage1Perturbation);
+  ModelInfo info;
+  info.fusion = Fusion::kInput;
+  info.lidars = {"top", "front_left", "front_right"};
+  info.stages = {1};
+  info.config_fingerprint = "3e6a9c876cf4b179";  // that version's model.json
+  write_model_info(folder, info);
+  const ModelFolder read = read_model_folder(folder);
+  EXPECT_EQ(read.config.stage1.uncertain_share, 0.0);
+  EXPECT_EQ(read.config.stage1.epochs, 8);
+  // The same text as a user's --config means today's default: stage 1 sees perturbed frames, another model.
+  const DetectConfig as_user_config = apply_detect_config(kYamlBeforeStage1Perturbation, "detect.yaml");
+  EXPECT_EQ(as_user_config.stage1.uncertain_share, 0.6);
+  EXPECT_NE(detect_config_fingerprint(as_user_config), info.config_fingerprint);
+}
+
 TEST(ModelFolder, AFolderWithoutAModelSaysWhy) {
   const fs::path folder = test::scratch_dir();
   try {

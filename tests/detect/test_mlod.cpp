@@ -161,6 +161,17 @@ std::vector<double> logged_losses(const fs::path& model) {
   return losses;
 }
 
+/// The sum over the log's lines of one logged term.
+double logged_term(const fs::path& model, const std::string& term) {
+  double sum = 0.0;
+  std::istringstream lines(log_text(model));
+  for (std::string line; std::getline(lines, line);) {
+    const auto at = line.find("\"" + term + "\":");
+    if (at != std::string::npos) sum += std::stod(line.substr(at + term.size() + 3));
+  }
+  return sum;
+}
+
 TEST(MlodTraining, IsDeterministicForASeedAndResumesExactly) {
   const fs::path dir = test::scratch_dir();
   const fs::path data = cars_dataset(dir / "data", 4, sim::DetectionSplit::kTrain);
@@ -190,6 +201,8 @@ TEST(MlodTraining, IsDeterministicForASeedAndResumesExactly) {
   train_detector(request);
   EXPECT_EQ(logged_losses(dir / "c"), a);
   EXPECT_TRUE(fs::exists(dir / "c" / "loss.svg"));
+  // Stage 1 saw perturbed frames (stage1.uncertain_share 0.6 by default): the log's mean alpha is not 0 on every line.
+  EXPECT_GT(logged_term(dir / "a", "alpha"), 0.0);
   // Resuming with another configuration is refused with the reason.
   request.config.stage1.learning_rate *= 2.0;
   try {

@@ -71,7 +71,7 @@ void read_anchors(const io::YamlFields& fields, const YAML::Node& map, AnchorCon
 
 void read_stage1(const io::YamlFields& fields, const YAML::Node& map, Stage1TrainConfig& stage1) {
   fields.only_keys(map, "stage1", {"epochs", "learning_rate", "weight_decay", "focal_alpha", "focal_gamma", "regression_weight",
-                                   "direction_weight", "checkpoint_every"});
+                                   "direction_weight", "checkpoint_every", "uncertain_share"});
   const Section s(fields, map, "stage1");
   s.integer("epochs", 1, 100000, stage1.epochs);
   s.number("learning_rate", 1e-7, 1.0, stage1.learning_rate);
@@ -81,6 +81,7 @@ void read_stage1(const io::YamlFields& fields, const YAML::Node& map, Stage1Trai
   s.number("regression_weight", 0.0, 100.0, stage1.regression_weight);
   s.number("direction_weight", 0.0, 100.0, stage1.direction_weight);
   s.integer("checkpoint_every", 1, 1000000, stage1.checkpoint_every);
+  s.number("uncertain_share", 0.0, 1.0, stage1.uncertain_share);
 }
 
 void read_augment(const io::YamlFields& fields, const YAML::Node& map, AugmentConfig& augment) {
@@ -189,6 +190,12 @@ DetectConfig read_detect_config(const std::filesystem::path& path) {
   return apply_detect_config(io::read_file_text(path), path.string());
 }
 
+DetectConfig read_model_detect_config(const std::filesystem::path& path) {
+  DetectConfig before_the_key;
+  before_the_key.stage1.uncertain_share = 0.0;
+  return apply_detect_config(io::read_file_text(path), path.string(), before_the_key);
+}
+
 std::string format_detect_config(const DetectConfig& c) {
   const auto n = [](double value) { return io::exact_number(value); };
   std::ostringstream out;
@@ -203,6 +210,8 @@ std::string format_detect_config(const DetectConfig& c) {
       << "\n  weight_decay: " << n(c.stage1.weight_decay) << "\n  focal_alpha: " << n(c.stage1.focal_alpha)
       << "\n  focal_gamma: " << n(c.stage1.focal_gamma) << "\n  regression_weight: " << n(c.stage1.regression_weight)
       << "\n  direction_weight: " << n(c.stage1.direction_weight) << "\n  checkpoint_every: " << c.stage1.checkpoint_every
+      // Left out at 0, what folders written before the key meant: their fingerprints stay what they were.
+      << (c.stage1.uncertain_share > 0.0 ? "\n  uncertain_share: " + n(c.stage1.uncertain_share) : std::string())
       << "\naugmentation:\n  share: " << n(c.augment.share) << "\n  flip_y: " << (c.augment.flip_y ? "true" : "false")
       << "\n  translation_m: " << list({c.augment.translation_x_m, c.augment.translation_y_m, c.augment.translation_z_m})
       << "\n  rotation_deg: " << n(c.augment.rotation_deg) << "\n  scale: " << list({c.augment.scale_min, c.augment.scale_max})

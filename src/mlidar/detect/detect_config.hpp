@@ -26,6 +26,10 @@ struct Stage1TrainConfig {
   double regression_weight = 2.0;  ///< smooth-L1 of the anchor residuals, per positive
   double direction_weight = 0.2;   ///< the heading's half-turn classifier
   int checkpoint_every = 200;      ///< steps between checkpoints (rounded up to a multiple of the log's 10 steps)
+  /// Share of stage 1's training frames read with perturbed extrinsics (at stage2.alphas), the same 1 : 1.5 clean :
+  /// perturbed as stage 2's. The thesis trains stage 1 on clean frames only (0); measured here, such a stage 1 loses
+  /// 80 % of its AP at alpha 0.04 and stage 2 cannot give back the cars it never proposed (docs/benchmarks.md, MLOD).
+  double uncertain_share = 0.6;
 };
 
 /// 6.6.1.5-6.6.1.6's augmentation: a share of the samples is flipped about the x axis (y -> -y), moved and turned
@@ -77,7 +81,11 @@ struct DetectConfig {
 /// `config` with the keys of `yaml_text` applied; `source` names the file in errors.
 DetectConfig apply_detect_config(const std::string& yaml_text, const std::string& source, DetectConfig config = {});
 DetectConfig read_detect_config(const std::filesystem::path& path);
-/// Every key with its value (exact numbers): what a model folder keeps; apply_detect_config reads it back the same.
+/// A model or training folder's own detect.yaml: as read_detect_config, except that a key the folder's writer did not
+/// know yet has the value that writer used (stage1.uncertain_share: 0), so older folders keep their fingerprint.
+DetectConfig read_model_detect_config(const std::filesystem::path& path);
+/// Every key with its value (exact numbers; stage1.uncertain_share only when not 0): what a model folder keeps;
+/// read_model_detect_config reads it back the same.
 std::string format_detect_config(const DetectConfig& config);
 /// A short hex digest of format_detect_config (FNV-1a 64) with `threads` left out: two configurations that train
 /// different models differ.

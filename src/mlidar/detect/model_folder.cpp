@@ -90,7 +90,7 @@ ModelFolder read_model_folder(const fs::path& folder) {
   if (out.info.stages.empty() || out.info.stages.front() != 1) throw InputError(model.string(), "stages", "no trained stage 1");
   const fs::path yaml = folder / "detect.yaml";
   if (!fs::exists(yaml)) throw InputError(yaml.string(), "detect.yaml", "missing: the model's configuration is part of the model folder");
-  out.config = read_detect_config(yaml);
+  out.config = read_model_detect_config(yaml);
   const std::string fingerprint = detect_config_fingerprint(out.config);
   if (fingerprint != out.info.config_fingerprint) {
     throw InputError(yaml.string(), "config_fingerprint",

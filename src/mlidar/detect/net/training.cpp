@@ -146,6 +146,15 @@ void fit_temperatures(Session& session, net::BevNet& net) {
   }
 }
 
+/// The perturbation a training sample is read with (6.6.1.6): when `inject`, with probability `share` a level drawn
+/// from `alphas`, else 0 (clean); and the seed of its draw.
+std::pair<double, std::uint64_t> draw_perturbation(bool inject, double share, const std::vector<double>& alphas, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const bool uncertain = inject && unit(rng) < share;
+  const double alpha = uncertain ? alphas[static_cast<std::size_t>(unit(rng) * alphas.size()) % alphas.size()] : 0.0;
+  return {alpha, rng()};
+}
+
 void train_stage1(Session& session) {
   const DetectConfig& config = session.config;
   const Fusion fusion = session.record.fusion;
@@ -153,9 +162,15 @@ void train_stage1(Session& session) {
   net::BevNet net = net::make_stage1(config);
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(config.stage1.learning_rate).weight_decay(config.stage1.weight_decay));
   const long steps = stage_steps(session, config.stage1.epochs);
+  const bool inject = session.dataset.dataset_alpha() == 0.0 && !config.stage2.alphas.empty();
   session.records[1] = run_loop(session, 1, *net, optimizer, config.stage1.learning_rate, steps, [&](long step) {
     std::mt19937_64 rng(mix_seed(mix_seed(config.seed, 1), static_cast<std::uint64_t>(step) + 1000003));
-    DetectionFrame frame = select_lidars(session.dataset.read(frame_of_step(session, 1, step)), session.lidar_indices);
+    // Stage 1 draws nothing unless asked to see perturbed frames (the thesis trains it on clean ones).
+    const auto [alpha, perturbation_seed] = config.stage1.uncertain_share > 0.0
+                                                ? draw_perturbation(inject, config.stage1.uncertain_share, config.stage2.alphas, rng)
+                                                : std::pair<double, std::uint64_t>{0.0, 0};
+    DetectionFrame frame =
+        select_lidars(session.dataset.read(frame_of_step(session, 1, step), alpha, perturbation_seed), session.lidar_indices);
     augment_frame(draw_augmentation(config.augment, false, rng), frame);
     const std::vector<io::Box3D> boxes = boxes_of_class(frame.labels, config.object_class);
     const std::vector<torch::Tensor> output = net::run_stage1(net, net::stage1_grids(frame, fusion, config.grid), fusion);
@@ -170,6 +185,7 @@ void train_stage1(Session& session) {
       terms["regression"] += loss.regression.item<double>() / static_cast<double>(points.size());
       terms["direction"] += loss.direction.item<double>() / static_cast<double>(points.size());
     }
+    terms["alpha"] = alpha;
     optimizer.zero_grad();
     total.backward();
     optimizer.step();
@@ -197,11 +213,8 @@ void train_stage2(Session& session) {
   const bool inject = session.dataset.dataset_alpha() == 0.0 && !config.stage2.alphas.empty();
   session.records[2] = run_loop(session, 2, *refiner, optimizer, config.stage2.learning_rate, steps, [&](long step) {
     std::mt19937_64 rng(mix_seed(mix_seed(config.seed, 2), static_cast<std::uint64_t>(step) + 1000003));
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
     // 6.6.1.6: about 1 clean sample for 1.5 uncertain ones, each uncertain one at a level drawn from the alphas.
-    const bool uncertain = inject && unit(rng) < config.stage2.uncertain_share;
-    const double alpha = uncertain ? config.stage2.alphas[static_cast<std::size_t>(unit(rng) * config.stage2.alphas.size()) % config.stage2.alphas.size()] : 0.0;
-    const std::uint64_t perturbation_seed = rng();
+    const auto [alpha, perturbation_seed] = draw_perturbation(inject, config.stage2.uncertain_share, config.stage2.alphas, rng);
     DetectionFrame frame = select_lidars(session.dataset.read(frame_of_step(session, 2, step), alpha, perturbation_seed), session.lidar_indices);
     augment_frame(draw_augmentation(config.augment, true, rng), frame);
     const std::vector<io::Box3D> boxes = boxes_of_class(frame.labels, config.object_class);
