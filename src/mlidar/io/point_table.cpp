@@ -101,6 +101,9 @@ double FieldColumn::value(std::size_t point, std::uint32_t element) const {
 }
 
 std::vector<double> FieldColumn::values(std::size_t num_points, std::uint32_t element) const {
+  if (num_points > 0 && (element >= count || data.size() < num_points * stride())) {
+    throw std::invalid_argument("FieldColumn::values: field " + name + " holds fewer than " + std::to_string(num_points) + " points");
+  }
   std::vector<double> out(num_points);
   if (num_points == 0) return out;
   const std::byte* first = data.data() + element * scalar_size(type);

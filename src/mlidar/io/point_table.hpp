@@ -33,7 +33,8 @@ struct FieldColumn {
   /// Element `element` of point `point`, converted to double.
   double value(std::size_t point, std::uint32_t element = 0) const;
   /// Element `element` of every one of the first `num_points` points, converted to double as value() does (one
-  /// pass with the type resolved once: what whole-cloud conversions use).
+  /// pass with the type resolved once: what whole-cloud conversions use). std::invalid_argument when the column is
+  /// shorter.
   std::vector<double> values(std::size_t num_points, std::uint32_t element = 0) const;
 };
 
