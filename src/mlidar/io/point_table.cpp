@@ -67,37 +67,39 @@ double load(const std::byte* p) {
   return static_cast<double>(v);
 }
 
-template <typename T>
-void load_all(const std::byte* first, std::size_t stride, std::span<double> out) {
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = load<T>(first + i * stride);
+/// `read.template operator()<T>()` with T the C++ type of `type` (the one switch over the types that value and values
+/// share); a value outside the enum reads nothing and gives 0.
+template <typename Read>
+double with_scalar_type(ScalarType type, Read&& read) {
+  switch (type) {
+    case ScalarType::kI8:
+      return read.template operator()<std::int8_t>();
+    case ScalarType::kU8:
+      return read.template operator()<std::uint8_t>();
+    case ScalarType::kI16:
+      return read.template operator()<std::int16_t>();
+    case ScalarType::kU16:
+      return read.template operator()<std::uint16_t>();
+    case ScalarType::kI32:
+      return read.template operator()<std::int32_t>();
+    case ScalarType::kU32:
+      return read.template operator()<std::uint32_t>();
+    case ScalarType::kI64:
+      return read.template operator()<std::int64_t>();
+    case ScalarType::kU64:
+      return read.template operator()<std::uint64_t>();
+    case ScalarType::kF32:
+      return read.template operator()<float>();
+    case ScalarType::kF64:
+      return read.template operator()<double>();
+  }
+  return 0.0;
 }
 }  // namespace
 
 double FieldColumn::value(std::size_t point, std::uint32_t element) const {
   const std::byte* p = data.data() + point * stride() + element * scalar_size(type);
-  switch (type) {
-    case ScalarType::kI8:
-      return load<std::int8_t>(p);
-    case ScalarType::kU8:
-      return load<std::uint8_t>(p);
-    case ScalarType::kI16:
-      return load<std::int16_t>(p);
-    case ScalarType::kU16:
-      return load<std::uint16_t>(p);
-    case ScalarType::kI32:
-      return load<std::int32_t>(p);
-    case ScalarType::kU32:
-      return load<std::uint32_t>(p);
-    case ScalarType::kI64:
-      return load<std::int64_t>(p);
-    case ScalarType::kU64:
-      return load<std::uint64_t>(p);
-    case ScalarType::kF32:
-      return load<float>(p);
-    case ScalarType::kF64:
-      return load<double>(p);
-  }
-  return 0.0;
+  return with_scalar_type(type, [p]<typename T>() { return load<T>(p); });
 }
 
 std::vector<double> FieldColumn::values(std::size_t num_points, std::uint32_t element) const {
@@ -108,38 +110,10 @@ std::vector<double> FieldColumn::values(std::size_t num_points, std::uint32_t el
   if (num_points == 0) return out;
   const std::byte* first = data.data() + element * scalar_size(type);
   const std::size_t step = stride();
-  switch (type) {
-    case ScalarType::kI8:
-      load_all<std::int8_t>(first, step, out);
-      break;
-    case ScalarType::kU8:
-      load_all<std::uint8_t>(first, step, out);
-      break;
-    case ScalarType::kI16:
-      load_all<std::int16_t>(first, step, out);
-      break;
-    case ScalarType::kU16:
-      load_all<std::uint16_t>(first, step, out);
-      break;
-    case ScalarType::kI32:
-      load_all<std::int32_t>(first, step, out);
-      break;
-    case ScalarType::kU32:
-      load_all<std::uint32_t>(first, step, out);
-      break;
-    case ScalarType::kI64:
-      load_all<std::int64_t>(first, step, out);
-      break;
-    case ScalarType::kU64:
-      load_all<std::uint64_t>(first, step, out);
-      break;
-    case ScalarType::kF32:
-      load_all<float>(first, step, out);
-      break;
-    case ScalarType::kF64:
-      load_all<double>(first, step, out);
-      break;
-  }
+  with_scalar_type(type, [&]<typename T>() {
+    for (std::size_t i = 0; i < num_points; ++i) out[i] = load<T>(first + i * step);
+    return 0.0;
+  });
   return out;
 }
 
