@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <numeric>
 
 #include <gtest/gtest.h>
 
@@ -150,27 +151,19 @@ fs::path cars_dataset(const fs::path& folder, int frames, sim::DetectionSplit sp
 
 std::string log_text(const fs::path& model) { return test::read_text(model / "train_log.jsonl"); }
 
-/// The losses of the log's lines (the seconds differ between runs).
-std::vector<double> logged_losses(const fs::path& model) {
-  std::vector<double> losses;
-  std::istringstream lines(log_text(model));
-  for (std::string line; std::getline(lines, line);) {
-    const auto at = line.find("\"loss\":");
-    losses.push_back(std::stod(line.substr(at + 7)));
-  }
-  return losses;
-}
-
-/// The sum over the log's lines of one logged term.
-double logged_term(const fs::path& model, const std::string& term) {
-  double sum = 0.0;
+/// One logged term of every line of the log, in order.
+std::vector<double> logged_values(const fs::path& model, const std::string& term) {
+  std::vector<double> values;
   std::istringstream lines(log_text(model));
   for (std::string line; std::getline(lines, line);) {
     const auto at = line.find("\"" + term + "\":");
-    if (at != std::string::npos) sum += std::stod(line.substr(at + term.size() + 3));
+    if (at != std::string::npos) values.push_back(std::stod(line.substr(at + term.size() + 3)));
   }
-  return sum;
+  return values;
 }
+
+/// The losses of the log's lines (the seconds differ between runs).
+std::vector<double> logged_losses(const fs::path& model) { return logged_values(model, "loss"); }
 
 TEST(MlodTraining, IsDeterministicForASeedAndResumesExactly) {
   const fs::path dir = test::scratch_dir();
@@ -202,7 +195,8 @@ TEST(MlodTraining, IsDeterministicForASeedAndResumesExactly) {
   EXPECT_EQ(logged_losses(dir / "c"), a);
   EXPECT_TRUE(fs::exists(dir / "c" / "loss.svg"));
   // Stage 1 saw perturbed frames (stage1.uncertain_share 0.6 by default): the log's mean alpha is not 0 on every line.
-  EXPECT_GT(logged_term(dir / "a", "alpha"), 0.0);
+  const std::vector<double> alphas = logged_values(dir / "a", "alpha");
+  EXPECT_GT(std::accumulate(alphas.begin(), alphas.end(), 0.0), 0.0);
   // Resuming with another configuration is refused with the reason.
   request.config.stage1.learning_rate *= 2.0;
   try {
