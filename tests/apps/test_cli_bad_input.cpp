@@ -18,7 +18,6 @@
 namespace mlidar::test {
 namespace {
 
-
 /// Rewrites the t field of a scan: t' = scale * t + shift.
 void retime(const fs::path& scan, double scale, double shift) {
   io::CloudFile cloud = io::read_cloud(scan);

@@ -19,7 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(std::ifstream(path)); }
 
 /// TUM lines of a curve; `offset_x` shifts every position along x.

@@ -15,7 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 const std::string kCarAt10 = "car 0 0 -10 -1 -1 -1 -1 1.5 1.8 4.4 10 0 -1.7 0.3";
 const std::string kCarAt15 = "Car 0 0 -10 -1 -1 -1 -1 1.5 1.8 4.4 0 15 -1.7 1.2";
 const std::string kPedestrianAt8 = "pedestrian 0 0 -10 -1 -1 -1 -1 1.8 0.6 0.5 -8 2 -1.7 0";
