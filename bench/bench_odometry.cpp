@@ -2,6 +2,7 @@
 // stage on the top LiDAR, one scan-to-map registration, and whole frames with
 // 1-4 of the rv rig's LiDARs (issue 7's scaling, thesis Table 4.7).
 #include <algorithm>
+#include <array>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -22,6 +23,7 @@ struct Sequence {
   sim::SimRig rig = sim::named_rig("rv");
   std::vector<LidarSetup> lidars;
   std::vector<Frame> frames;
+  std::vector<SE3> T_world_base;  ///< the true pose at each frame's stamp
 
   Sequence() {
     const auto trajectory = sim::SimTrajectory::named("vehicle", rig.base_height);
@@ -35,6 +37,7 @@ struct Sequence {
       for (std::size_t i = 0; i < rig.lidars.size(); ++i)
         frame.scans.push_back(
             sim::simulate_sweep(scene, rig.lidars[i], trajectory, frame.stamp, sim::sweep_seed(3, static_cast<std::uint64_t>(k), i)).scan);
+      T_world_base.push_back(trajectory.T_world_base(frame.stamp));
       frames.push_back(std::move(frame));
     }
   }
@@ -143,6 +146,48 @@ const RegistrationCase& registration_case() {
   }();
   return built;
 }
+
+/// The features of all LiDARs of frame k (base frame, deskewed).
+LidarFeatures frame_features(const Sequence& data, std::size_t k) {
+  const OdometryConfig config;
+  LidarFeatures all;
+  for (std::size_t i = 0; i < data.lidars.size(); ++i) {
+    FrontEndWorkspace ws;
+    LidarFeatures one;
+    StageSeconds seconds{};
+    run_front_end(data.frames[k].scans[i], data.frames[k].stamp, data.lidars[i], {}, config.front_end, ws, one, seconds);
+    all.planes.insert(all.planes.end(), one.planes.begin(), one.planes.end());
+  }
+  return all;
+}
+
+/// The map-neighbour search of scan-to-map registration: the last frame's plane features (all LiDARs, at the true
+/// pose) against a plane map of the frames before (default voxel and bucket sizes, k = 5 within 1 m).
+void BM_MapNearest(benchmark::State& state) {
+  const Sequence& data = sequence();
+  const OdometryConfig config;
+  VoxelMap map(config.plane_voxel_m, config.plane_points_per_voxel);
+  std::vector<Eigen::Vector3f> queries;
+  for (std::size_t k = 0; k < data.frames.size(); ++k) {
+    std::vector<Eigen::Vector3f> world = frame_features(data, k).planes;
+    for (Eigen::Vector3f& p : world) p = (data.T_world_base[k] * Vec3(p.cast<double>())).cast<float>();
+    if (k + 1 < data.frames.size())
+      map.add(world);
+    else
+      queries = std::move(world);
+  }
+  std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
+  std::size_t found = 0;
+  for (auto _ : state) {
+    found = 0;
+    for (const Eigen::Vector3f& q : queries) found += static_cast<std::size_t>(map.nearest(q, config.registration.neighbors, 1.0F, near));
+    benchmark::DoNotOptimize(near.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(queries.size()));  // queries per second
+  state.counters["queries"] = static_cast<double>(queries.size());
+  state.counters["found_per_query"] = static_cast<double>(found) / static_cast<double>(queries.size());
+}
+BENCHMARK(BM_MapNearest)->Unit(benchmark::kMillisecond);
 
 /// Frame 1's features of all LiDARs registered to a map of frame 0's.
 void BM_RegisterScanToMap(benchmark::State& state) {

@@ -125,6 +125,60 @@ TEST(VoxelMap, NearestMatchesBruteForceWithinOneVoxel) {
   }
 }
 
+TEST(VoxelMap, NearestMatchesBruteForceForEveryKAndRadius) {
+  // Points on three planes through a 4 m cube (as a map of plane features), queries near them and near voxel faces.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<float> u(-2.0F, 2.0F);
+  std::normal_distribution<float> noise(0.0F, 0.02F);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 900; ++i) {  // sparse: the k-th neighbour is often in the far layer of some axis
+    const float a = u(rng), b = u(rng), n = noise(rng);
+    points.push_back(i % 3 == 0   ? Eigen::Vector3f(a, b, n)
+                     : i % 3 == 1 ? Eigen::Vector3f(n + 1.0F, a, b)
+                                  : Eigen::Vector3f(a, n - 0.5F, b));
+  }
+  for (int i = 0; i < 200; ++i) points.emplace_back(u(rng), u(rng), u(rng));  // scattered: neighbours in the corners too
+  const double voxel = 0.5;
+  VoxelMap map(voxel, 10000);
+  map.add(points);
+  for (int trial = 0; trial < 300; ++trial) {
+    Eigen::Vector3f q =
+        points[static_cast<std::size_t>(trial * 13) % points.size()] + Eigen::Vector3f(noise(rng), noise(rng), noise(rng)) * 5.0F;
+    if (trial % 4 == 0) q.x() = std::round(q.x() / 0.5F) * 0.5F + noise(rng) * 0.05F;  // by a voxel face
+    const int k = 1 + trial % VoxelMap::kMaxNeighbors;
+    const float radius_sq = trial % 2 == 0 ? 0.25F : 0.01F;  // at most one voxel: the 27-voxel search is exact
+    std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
+    const int count = map.nearest(q, k, radius_sq, near);
+    std::vector<float> brute;
+    for (const auto& p : points)
+      if ((p - q).squaredNorm() <= radius_sq) brute.push_back((p - q).squaredNorm());
+    std::sort(brute.begin(), brute.end());
+    ASSERT_EQ(count, static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(k), brute.size()))) << "trial " << trial;
+    for (int i = 0; i < count; ++i)
+      EXPECT_EQ((near[static_cast<std::size_t>(i)] - q).squaredNorm(), brute[static_cast<std::size_t>(i)])
+          << "trial " << trial << " neighbour " << i;
+  }
+}
+
+TEST(VoxelMap, NearestFindsALonePointInEachOfTheTwentySixNeighbours) {
+  for (const float shift : {-0.2F, 0.0F, 0.2F}) {  // the query left of, at and right of its voxel's middle
+    const Eigen::Vector3f q = Eigen::Vector3f::Constant(0.5F + shift);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          // The point of the neighbour's box nearest q, 5 cm inside it: within 1 m of q for every neighbour.
+          const auto inside = [](int offset, float coordinate) { return offset < 0 ? -0.05F : offset > 0 ? 1.05F : coordinate; };
+          const Eigen::Vector3f p(inside(dx, q.x()), inside(dy, q.y()), inside(dz, q.z()));
+          VoxelMap map(1.0, 20);
+          map.add(std::vector<Eigen::Vector3f>{p});
+          std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
+          const float radius_sq = (p - q).squaredNorm() + 1e-4F;
+          ASSERT_EQ(map.nearest(q, 3, radius_sq, near), 1) << dx << " " << dy << " " << dz << " shift " << shift;
+          EXPECT_EQ(near[0], p);
+        }
+  }
+}
+
 TEST(VoxelMap, BoundsPointsPerVoxelAndRemovesFarVoxels) {
   VoxelMap map(1.0, 3);
   std::vector<Eigen::Vector3f> same(10, Eigen::Vector3f(0.5F, 0.5F, 0.5F));

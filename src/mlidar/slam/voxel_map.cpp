@@ -1,5 +1,6 @@
 #include "mlidar/slam/voxel_map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -62,16 +63,38 @@ void VoxelMap::remove_far(const Eigen::Vector3f& origin, double max_distance) {
 
 namespace {
 
-/// One of the 27 voxels around a query and a lower bound of its points' squared distance from it.
-struct NearbyVoxel {
-  float bound_sq;
-  std::int8_t dx, dy, dz;
+/// A neighbour of the query's voxel as, per axis, 0 (the same layer), 1 (the layer on the side of the voxel the
+/// query is nearer to, at most half an edge away) or 2 (the far side, at least half an edge away).
+using Sides = std::array<std::uint8_t, 3>;
+
+/// The 26 neighbours, those with fewer far sides, then fewer near sides, first: so the boxes nearest a query
+/// usually come first and tighten the k-th best distance before the farther ones are judged.
+constexpr std::array<Sides, 26> kNeighbourSides = [] {
+  std::array<Sides, 26> order{};
+  std::size_t next = 0;
+  for (int far = 0; far <= 3; ++far)
+    for (int near = 0; near + far <= 3; ++near)
+      for (std::uint8_t x = 0; x <= 2; ++x)
+        for (std::uint8_t y = 0; y <= 2; ++y)
+          for (std::uint8_t z = 0; z <= 2; ++z)
+            if ((x == 1) + (y == 1) + (z == 1) == near && (x == 2) + (y == 2) + (z == 2) == far && near + far > 0)
+              order[next++] = {x, y, z};
+  return order;
+}();
+
+/// One axis of a query's position in its voxel: per side (same, near, far) the voxel offset and the squared gap
+/// to that layer's box.
+struct AxisLayers {
+  std::array<std::int32_t, 3> offset;
+  std::array<float, 3> gap_sq;
 };
 
-/// Squared gap along one axis from a query at `fraction` (in [0, 1) voxels) of its voxel to the neighbour `offset` away.
-float axis_gap_sq(float fraction, int offset, float size) {
-  const float gap = offset < 0 ? fraction * size : offset > 0 ? (1.0F - fraction) * size : 0.0F;
-  return gap * gap;
+/// `fraction` in [0, 1): where the query lies along the axis of its voxel of edge `size`.
+AxisLayers axis_layers(float fraction, float size) {
+  const float below = fraction * size;
+  const float above = (1.0F - fraction) * size;
+  if (fraction < 0.5F) return {{0, -1, 1}, {0.0F, below * below, above * above}};
+  return {{0, 1, -1}, {0.0F, above * above, below * below}};
 }
 
 }  // namespace
@@ -81,43 +104,13 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
   if (k <= 0) return 0;
   std::array<float, kMaxNeighbors> best_sq{};
   int found = 0;
-  const VoxelKey center = key_of(q);
-  // Visit the 27 voxels nearest-box first and skip those that cannot hold a
-  // point nearer than the radius or the k-th best so far (exact: the bound is
-  // the distance to the voxel's box, shrunk a little against rounding).
-  const double inv = 1.0 / voxel_size_;
-  const auto size = static_cast<float>(voxel_size_);
-  const auto fraction_of = [inv](float coordinate, std::int32_t cell) {
-    return static_cast<float>(static_cast<double>(coordinate) * inv - cell);
-  };
-  const Eigen::Vector3f fraction(fraction_of(q.x(), center.x), fraction_of(q.y(), center.y), fraction_of(q.z(), center.z));
-  std::array<NearbyVoxel, 27> order{};
-  int voxels = 0;
-  for (int dx = -1; dx <= 1; ++dx) {
-    const float gx = axis_gap_sq(fraction.x(), dx, size);
-    for (int dy = -1; dy <= 1; ++dy) {
-      const float gxy = gx + axis_gap_sq(fraction.y(), dy, size);
-      for (int dz = -1; dz <= 1; ++dz) {
-        const float bound = (gxy + axis_gap_sq(fraction.z(), dz, size)) * 0.999F - 1e-6F;
-        if (bound > max_distance_sq) continue;
-        int slot = voxels++;
-        while (slot > 0 && order[static_cast<std::size_t>(slot - 1)].bound_sq > bound) {
-          order[static_cast<std::size_t>(slot)] = order[static_cast<std::size_t>(slot - 1)];
-          --slot;
-        }
-        order[static_cast<std::size_t>(slot)] = {bound, static_cast<std::int8_t>(dx), static_cast<std::int8_t>(dy),
-                                                 static_cast<std::int8_t>(dz)};
-      }
-    }
-  }
-  for (int v = 0; v < voxels; ++v) {
-    const NearbyVoxel& voxel = order[static_cast<std::size_t>(v)];
-    if (found == k && voxel.bound_sq >= best_sq[static_cast<std::size_t>(k - 1)]) break;
-    const auto it = map_.find({center.x + voxel.dx, center.y + voxel.dy, center.z + voxel.dz});
-    if (it == map_.end()) continue;
+  const auto kth = static_cast<std::size_t>(k - 1);
+  const auto visit = [&](const VoxelKey& key) {
+    const auto it = map_.find(key);
+    if (it == map_.end()) return;
     for (const auto& p : it->second) {
       const float d = (p - q).squaredNorm();
-      if (d > max_distance_sq || (found == k && d >= best_sq[static_cast<std::size_t>(k - 1)])) continue;
+      if (d > max_distance_sq || (found == k && d >= best_sq[kth])) continue;
       int slot = found < k ? found++ : k - 1;  // insertion sort into the sorted prefix
       while (slot > 0 && best_sq[static_cast<std::size_t>(slot - 1)] > d) {
         best_sq[static_cast<std::size_t>(slot)] = best_sq[static_cast<std::size_t>(slot - 1)];
@@ -127,6 +120,23 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
       best_sq[static_cast<std::size_t>(slot)] = d;
       out[static_cast<std::size_t>(slot)] = p;
     }
+  };
+  const VoxelKey center = key_of(q);
+  visit(center);
+  // A neighbour is searched only when its box (a lower bound of its points' squared distance, shrunk a little
+  // against rounding) is within the radius and, once k are found, nearer than the k-th best: exact.
+  const double inv = 1.0 / voxel_size_;
+  const auto size = static_cast<float>(voxel_size_);
+  const auto fraction_of = [inv](float coordinate, std::int32_t cell) {
+    return static_cast<float>(static_cast<double>(coordinate) * inv - cell);
+  };
+  const AxisLayers x = axis_layers(fraction_of(q.x(), center.x), size);
+  const AxisLayers y = axis_layers(fraction_of(q.y(), center.y), size);
+  const AxisLayers z = axis_layers(fraction_of(q.z(), center.z), size);
+  for (const auto& [sx, sy, sz] : kNeighbourSides) {
+    const float bound = (x.gap_sq[sx] + y.gap_sq[sy] + z.gap_sq[sz]) * 0.999F - 1e-6F;
+    if (bound > max_distance_sq || (found == k && bound >= best_sq[kth])) continue;
+    visit({center.x + x.offset[sx], center.y + y.offset[sy], center.z + z.offset[sz]});
   }
   return found;
 }

@@ -1,8 +1,8 @@
 #pragma once
 // Voxel-hashed local map (tsl::robin_map from integer voxel coordinates to a
 // small bounded bucket of points), the structure of KISS-ICP's VoxelHashMap:
-// insertion O(1), a k-nearest query scans the 27 voxels around the query,
-// nearest box first, stopping at the first that cannot beat the k-th best.
+// insertion O(1), a k-nearest query scans the query's voxel, then those of
+// its 26 neighbours (faces, edges, corners) whose box can still beat the k-th best.
 // Not thread-safe for writes; const queries may run concurrently.
 #include <array>
 #include <cstdint>
