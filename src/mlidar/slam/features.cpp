@@ -1,6 +1,7 @@
 #include "mlidar/slam/features.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -33,21 +34,31 @@ void block_neighbours(int i, int n, std::span<std::uint8_t> blocked) {
   for (int k = std::max(0, i - kHalfWindow); k <= std::min(n - 1, i + kHalfWindow); ++k) blocked[static_cast<std::size_t>(k)] = 1;
 }
 
-/// Calls visit(i) on `candidates` in `before` order until it returns true or
+/// A candidate's sort key: the bits of its curvature (ordered as the values, curvature being >= 0), complemented
+/// when the highest come first, above its position in the row (equal curvatures: the earlier position first).
+std::uint64_t candidate_key(float curvature, bool highest_first, std::uint32_t position) {
+  std::uint32_t bits = std::bit_cast<std::uint32_t>(curvature);
+  if (highest_first) bits = ~bits;
+  return (static_cast<std::uint64_t>(bits) << 32U) | position;
+}
+
+std::uint32_t position_of(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xFFFFFFFFU); }
+
+/// Calls visit(position) on `candidates` in key order until it returns true or
 /// they run out. Sorts lazily: a chunk (starting at 2 * wanted, doubling) is
 /// selected with nth_element and sorted only when the walk reaches it, since
 /// most picks end within the first few (a full sort per sector was 8 % of slam).
-template <typename Before, typename Visit>
-void walk_in_order(std::vector<std::uint32_t>& candidates, int wanted, Before before, Visit visit) {
+template <typename Visit>
+void walk_in_order(std::vector<std::uint64_t>& candidates, int wanted, Visit visit) {
   if (wanted <= 0) return;
   auto first = candidates.begin();
   auto chunk = static_cast<std::ptrdiff_t>(2 * wanted);
   while (first != candidates.end()) {
     const auto last = candidates.end() - first > chunk ? first + chunk : candidates.end();
-    if (last != candidates.end()) std::nth_element(first, last, candidates.end(), before);
-    std::sort(first, last, before);
+    if (last != candidates.end()) std::nth_element(first, last, candidates.end());
+    std::sort(first, last);
     for (; first != last; ++first)
-      if (visit(*first)) return;
+      if (visit(position_of(*first))) return;
     chunk *= 2;
   }
 }
@@ -94,33 +105,36 @@ void extract_features(const RangeImage& image, const Segmentation& segmentation,
       const int begin = kHalfWindow + (n - 2 * kHalfWindow) * s / config.sectors;
       const int end = kHalfWindow + (n - 2 * kHalfWindow) * (s + 1) / config.sectors;
       if (end <= begin) continue;
-      // Edges: candidates above edge_threshold, highest curvature first.
-      ws.order.clear();
-      for (int i = begin; i < end; ++i)
-        if (curvature[static_cast<std::size_t>(i)] > config.edge_threshold) ws.order.push_back(static_cast<std::uint32_t>(i));
+      // Candidates: edges above edge_threshold (highest curvature first), planes below plane_threshold (lowest
+      // first), gathered in one pass without branches (each is written, then kept by advancing the end).
+      ws.edge_candidates.resize(static_cast<std::size_t>(end - begin));
+      ws.plane_candidates.resize(static_cast<std::size_t>(end - begin));
+      std::size_t edge_count = 0, plane_count = 0;
+      for (int i = begin; i < end; ++i) {
+        const float c = curvature[static_cast<std::size_t>(i)];
+        const auto position = static_cast<std::uint32_t>(i);
+        ws.edge_candidates[edge_count] = candidate_key(c, true, position);
+        edge_count += static_cast<std::size_t>(c > config.edge_threshold);
+        ws.plane_candidates[plane_count] = candidate_key(c, false, position);
+        plane_count += static_cast<std::size_t>(c < config.plane_threshold);
+      }
+      ws.edge_candidates.resize(edge_count);
+      ws.plane_candidates.resize(plane_count);
       int edges = 0;
-      walk_in_order(
-          ws.order, config.edges_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] > curvature[b]; },
-          [&](std::uint32_t i) {
-            const std::size_t pixel = ws.pixel[i];
-            if (ws.blocked[i] != 0 || segmentation.label[pixel] == Segmentation::kGround) return false;
-            out.edges.push_back(static_cast<std::uint32_t>(image.index[pixel]));
-            block_neighbours(static_cast<int>(i), n, ws.blocked);
-            return ++edges >= config.edges_per_sector;
-          });
-      // Planes: candidates below plane_threshold, lowest curvature first.
-      ws.order.clear();
-      for (int i = begin; i < end; ++i)
-        if (curvature[static_cast<std::size_t>(i)] < config.plane_threshold) ws.order.push_back(static_cast<std::uint32_t>(i));
+      walk_in_order(ws.edge_candidates, config.edges_per_sector, [&](std::uint32_t i) {
+        const std::size_t pixel = ws.pixel[i];
+        if (ws.blocked[i] != 0 || segmentation.label[pixel] == Segmentation::kGround) return false;
+        out.edges.push_back(static_cast<std::uint32_t>(image.index[pixel]));
+        block_neighbours(static_cast<int>(i), n, ws.blocked);
+        return ++edges >= config.edges_per_sector;
+      });
       int planes = 0;
-      walk_in_order(
-          ws.order, config.planes_per_sector, [&](std::uint32_t a, std::uint32_t b) { return curvature[a] < curvature[b]; },
-          [&](std::uint32_t i) {
-            if (ws.blocked[i] != 0) return false;
-            out.planes.push_back(static_cast<std::uint32_t>(image.index[ws.pixel[i]]));
-            block_neighbours(static_cast<int>(i), n, ws.blocked);
-            return ++planes >= config.planes_per_sector;
-          });
+      walk_in_order(ws.plane_candidates, config.planes_per_sector, [&](std::uint32_t i) {
+        if (ws.blocked[i] != 0) return false;
+        out.planes.push_back(static_cast<std::uint32_t>(image.index[ws.pixel[i]]));
+        block_neighbours(static_cast<int>(i), n, ws.blocked);
+        return ++planes >= config.planes_per_sector;
+      });
     }
   }
 }

@@ -42,7 +42,8 @@ struct FeatureWorkspace {
   std::vector<std::uint32_t> pixel;  ///< kept pixels of the current row
   std::vector<float> curvature;
   std::vector<std::uint8_t> blocked;
-  std::vector<std::uint32_t> order;
+  std::vector<std::uint64_t> edge_candidates;  ///< of the current sector: sort keys (curvature, position)
+  std::vector<std::uint64_t> plane_candidates;
 };
 
 /// Curvature of kept pixels of one row (ranges in azimuth order) into `curvature`;
