@@ -45,6 +45,22 @@ TEST(RangeImage, RowsFromElevationMatchRings) {
     }
 }
 
+TEST(RangeImage, ColumnIsTheNearestAzimuthBinClockwiseFromX) {
+  const LidarModel model = test::uniform_model(16, -15.0, 15.0, 0.2);  // 1800 columns
+  // Column c holds azimuths -(c +- 0.5) bins (clockwise), so a bin and a fraction f away lands in c + round(f).
+  for (const int bin : {0, 1, 450, 899, 900, 901, 1350, 1799})
+    for (const double fraction : {-0.49, -0.3, 0.0, 0.3, 0.49, 0.51, -0.51}) {
+      const double azimuth_rad = -(bin + fraction) * 0.2 * std::numbers::pi / 180.0;
+      const std::vector<Eigen::Vector3f> point = {
+          Eigen::Vector3f(static_cast<float>(10.0 * std::cos(azimuth_rad)), static_cast<float>(10.0 * std::sin(azimuth_rad)), 0.0F)};
+      RangeImage image;
+      build_range_image(point, std::vector<std::uint16_t>{7}, model, image);
+      const int expected = ((bin + (fraction > 0.5 ? 1 : fraction < -0.5 ? -1 : 0)) % 1800 + 1800) % 1800;
+      const auto filled = std::find(image.index.begin(), image.index.end(), 0) - image.index.begin();
+      EXPECT_EQ(filled, image.pixel(7, expected)) << "bin " << bin << " fraction " << fraction;
+    }
+}
+
 struct SegmentedScene {
   test::CastScan cast;
   RangeImage image;

@@ -16,6 +16,18 @@ int nearest_row(std::span<const double> sorted_angles_deg, double elevation_deg)
   return static_cast<int>(row - sorted_angles_deg.begin());
 }
 
+namespace {
+
+/// std::lround of a column coordinate (|x| < 2^31) without the library call: halves away from zero, exactly
+/// (x minus its truncation is exact in double).
+int round_half_away(double x) {
+  const auto whole = static_cast<int>(x);
+  const double fraction = x - static_cast<double>(whole);
+  return whole + static_cast<int>(fraction >= 0.5) - static_cast<int>(fraction <= -0.5);
+}
+
+}  // namespace
+
 double fast_atan2(double y, double x) {
   const double ax = std::abs(x);
   const double ay = std::abs(y);
@@ -66,8 +78,11 @@ void build_range_image(std::span<const Eigen::Vector3f> points, std::span<const 
     }
     // Clockwise azimuth, the firing order of spinning sensors (sim/acquisition.hpp).
     const double azimuth_deg = -fast_atan2(static_cast<double>(p.y()), static_cast<double>(p.x())) * degrees;
-    int col = static_cast<int>(std::lround(azimuth_deg * cols_per_degree)) % image.cols;
-    if (col < 0) col += image.cols;
+    int col = round_half_away(azimuth_deg * cols_per_degree);
+    if (col < 0 || col >= image.cols) {  // one turn either way at most: the azimuth is within half a turn
+      col %= image.cols;
+      if (col < 0) col += image.cols;
+    }
     const std::size_t pixel = image.pixel(row, col);
     if (image.index[pixel] == RangeImage::kEmpty || range < image.range[pixel]) {
       image.range[pixel] = static_cast<float>(range);
