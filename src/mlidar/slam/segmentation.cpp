@@ -67,45 +67,48 @@ void segment_range_image(const RangeImage& image, std::span<const Eigen::Vector3
   }
   out.queue.resize(pixels);
   out.clusters = 0;
-  for (std::size_t seed = 0; seed < pixels; ++seed) {
-    if (out.label[seed] != kUnvisited) continue;
-    const std::int32_t id = out.clusters + 1;
-    std::size_t head = 0;
-    std::size_t tail = 0;
-    out.queue[tail++] = static_cast<std::uint32_t>(seed);
-    out.label[seed] = id;
-    int min_row = image.rows;
-    int max_row = -1;
-    while (head < tail) {
-      const std::size_t p = out.queue[head++];
-      const int row = static_cast<int>(p / static_cast<std::size_t>(image.cols));
-      const int col = static_cast<int>(p % static_cast<std::size_t>(image.cols));
-      min_row = std::min(min_row, row);
-      max_row = std::max(max_row, row);
-      const int neighbours[4][2] = {
-          {row, (col + 1) % image.cols}, {row, (col + image.cols - 1) % image.cols}, {row - 1, col}, {row + 1, col}};
-      for (const auto& [nrow, ncol] : neighbours) {
-        if (nrow < 0 || nrow >= image.rows) continue;
-        const std::size_t q = image.pixel(nrow, ncol);
-        if (out.label[q] != kUnvisited) continue;
-        double sin_step = sin_h;
-        double cos_step = cos_h;
-        if (nrow != row) {
-          const auto lower = static_cast<std::size_t>(std::min(nrow, row));
-          sin_step = sin_up[lower];
-          cos_step = cos_up[lower];
+  const int cols = image.cols;
+  for (int seed_row = 0; seed_row < image.rows; ++seed_row) {
+    for (int seed_col = 0; seed_col < cols; ++seed_col) {
+      const std::size_t seed = image.pixel(seed_row, seed_col);
+      if (out.label[seed] != kUnvisited) continue;
+      const std::int32_t id = out.clusters + 1;
+      std::size_t head = 0;
+      std::size_t tail = 0;
+      out.queue[tail++] = {seed_row, seed_col};
+      out.label[seed] = id;
+      int min_row = image.rows;
+      int max_row = -1;
+      while (head < tail) {
+        const auto [row, col] = out.queue[head++];
+        const std::size_t p = image.pixel(row, col);
+        min_row = std::min(min_row, row);
+        max_row = std::max(max_row, row);
+        const int neighbours[4][2] = {
+            {row, col + 1 == cols ? 0 : col + 1}, {row, col == 0 ? cols - 1 : col - 1}, {row - 1, col}, {row + 1, col}};
+        for (const auto& [nrow, ncol] : neighbours) {
+          if (nrow < 0 || nrow >= image.rows) continue;
+          const std::size_t q = image.pixel(nrow, ncol);
+          if (out.label[q] != kUnvisited) continue;
+          double sin_step = sin_h;
+          double cos_step = cos_h;
+          if (nrow != row) {
+            const auto lower = static_cast<std::size_t>(std::min(nrow, row));
+            sin_step = sin_up[lower];
+            cos_step = cos_up[lower];
+          }
+          if (!same_object(image.range[p], image.range[q], sin_step, cos_step, tan_threshold)) continue;
+          out.label[q] = id;
+          out.queue[tail++] = {nrow, ncol};
         }
-        if (!same_object(image.range[p], image.range[q], sin_step, cos_step, tan_threshold)) continue;
-        out.label[q] = id;
-        out.queue[tail++] = static_cast<std::uint32_t>(q);
       }
-    }
-    const bool large = static_cast<int>(tail) >= config.min_cluster_points;
-    const bool tall = max_row - min_row + 1 >= config.min_cluster_rows && static_cast<int>(tail) >= config.min_row_span_points;
-    if (large || tall) {
-      ++out.clusters;
-    } else {
-      for (std::size_t k = 0; k < tail; ++k) out.label[out.queue[k]] = Segmentation::kNone;
+      const bool large = static_cast<int>(tail) >= config.min_cluster_points;
+      const bool tall = max_row - min_row + 1 >= config.min_cluster_rows && static_cast<int>(tail) >= config.min_row_span_points;
+      if (large || tall) {
+        ++out.clusters;
+      } else {
+        for (std::size_t k = 0; k < tail; ++k) out.label[image.pixel(out.queue[k][0], out.queue[k][1])] = Segmentation::kNone;
+      }
     }
   }
 }

@@ -6,6 +6,7 @@
 // threshold, beta = atan2(d2 sin(alpha), d1 - d2 cos(alpha)), d1 >= d2 the
 // ranges, alpha the angular step between the two beams. Small clusters are
 // dropped: they give unreliable constraints.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -29,9 +30,9 @@ struct SegmentationConfig {
 struct Segmentation {
   static constexpr std::int32_t kNone = -1;  ///< empty pixel or dropped cluster
   static constexpr std::int32_t kGround = 0;
-  std::vector<std::int32_t> label;   ///< kNone, kGround or cluster id >= 1
-  int clusters = 0;                  ///< clusters kept
-  std::vector<std::uint32_t> queue;  ///< breadth-first workspace, reused
+  std::vector<std::int32_t> label;        ///< kNone, kGround or cluster id >= 1
+  int clusters = 0;                       ///< clusters kept
+  std::vector<std::array<int, 2>> queue;  ///< breadth-first workspace (row, column), reused
 
   bool kept(std::size_t pixel) const { return label[pixel] != kNone; }
 };
