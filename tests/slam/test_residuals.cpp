@@ -179,6 +179,23 @@ TEST(VoxelMap, NearestFindsALonePointInEachOfTheTwentySixNeighbours) {
   }
 }
 
+TEST(VoxelMap, AVoxelAddedAfterARemovalHoldsOnlyItsOwnPoints) {
+  VoxelMap map(1.0, 4);
+  map.add(
+      std::vector<Eigen::Vector3f>{{0.5F, 0.5F, 0.5F}, {0.6F, 0.5F, 0.5F}, {20.5F, 0.5F, 0.5F}, {20.6F, 0.5F, 0.5F}, {20.7F, 0.5F, 0.5F}});
+  map.remove_far(Eigen::Vector3f::Zero(), 10.0);  // the voxel at x = 20 goes
+  map.add(std::vector<Eigen::Vector3f>{{-3.5F, 0.5F, 0.5F}, {0.7F, 0.5F, 0.5F}});
+  std::vector<Eigen::Vector3f> kept = map.points();
+  std::sort(kept.begin(), kept.end(), [](const Eigen::Vector3f& a, const Eigen::Vector3f& b) { return a.x() < b.x(); });
+  ASSERT_EQ(kept.size(), 4U);
+  EXPECT_EQ(kept[0], Eigen::Vector3f(-3.5F, 0.5F, 0.5F));
+  EXPECT_EQ(kept[1], Eigen::Vector3f(0.5F, 0.5F, 0.5F));
+  EXPECT_EQ(kept[3], Eigen::Vector3f(0.7F, 0.5F, 0.5F));
+  std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors> near;
+  ASSERT_EQ(map.nearest({-3.5F, 0.5F, 0.5F}, 3, 1.0F, near), 1);  // the new voxel: its own point, none of the removed
+  EXPECT_EQ(map.voxels(), 2U);
+}
+
 TEST(VoxelMap, BoundsPointsPerVoxelAndRemovesFarVoxels) {
   VoxelMap map(1.0, 3);
   std::vector<Eigen::Vector3f> same(10, Eigen::Vector3f(0.5F, 0.5F, 0.5F));

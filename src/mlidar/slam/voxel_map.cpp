@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace mlidar::slam {
@@ -14,20 +15,31 @@ VoxelMap::VoxelMap(double voxel_size, int max_points_per_voxel) : voxel_size_(vo
 void VoxelMap::insert(const Eigen::Vector3f& p, const PointCovariance* covariance, std::uint8_t source) {
   if (!p.allFinite()) return;
   const VoxelKey key = key_of(p);
-  auto& bucket = map_[key];
-  if (bucket.empty()) bucket.reserve(static_cast<std::size_t>(max_points_));
-  if (static_cast<int>(bucket.size()) >= max_points_) return;
+  auto [it, added] = map_.try_emplace(key);
+  Bucket& bucket = it.value();
+  if (added) {
+    if (free_slots_.empty()) {
+      if (pool_.size() + static_cast<std::size_t>(max_points_) > std::numeric_limits<std::uint32_t>::max())
+        throw std::length_error("VoxelMap: more than 2^32 point slots (too many voxels or points per voxel)");
+      bucket.first = static_cast<std::uint32_t>(pool_.size());
+      pool_.resize(pool_.size() + static_cast<std::size_t>(max_points_));
+    } else {
+      bucket.first = free_slots_.back();
+      free_slots_.pop_back();
+    }
+  }
+  if (static_cast<int>(bucket.count) >= max_points_) return;
   if (covariance != nullptr) {
     auto& kept = covariances_[key];
-    kept.resize(bucket.size());  // points added without a covariance before this one: zero
+    kept.resize(bucket.count);  // points added without a covariance before this one: zero
     kept.push_back(*covariance);
   }
   if (source != kNoSource) {
     auto& kept = sources_[key];
-    kept.resize(bucket.size(), kNoSource);
+    kept.resize(bucket.count, kNoSource);
     kept.push_back(source);
   }
-  bucket.push_back(p);
+  pool_[bucket.first + bucket.count++] = p;
 }
 
 void VoxelMap::add(std::span<const Eigen::Vector3f> points) {
@@ -51,7 +63,8 @@ void VoxelMap::add(std::span<const Eigen::Vector3f> points, std::span<const std:
 void VoxelMap::remove_far(const Eigen::Vector3f& origin, double max_distance) {
   const float limit_sq = static_cast<float>(max_distance * max_distance);
   for (auto it = map_.begin(); it != map_.end();) {
-    if ((it->second.front() - origin).squaredNorm() > limit_sq) {
+    if ((pool_[it->second.first] - origin).squaredNorm() > limit_sq) {
+      free_slots_.push_back(it->second.first);
       covariances_.erase(it->first);
       sources_.erase(it->first);
       it = map_.erase(it);
@@ -108,7 +121,7 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
   const auto visit = [&](const VoxelKey& key) {
     const auto it = map_.find(key);
     if (it == map_.end()) return;
-    for (const auto& p : it->second) {
+    for (const auto& p : points_of(it->second)) {
       const float d = (p - q).squaredNorm();
       if (d > max_distance_sq || (found == k && d >= best_sq[kth])) continue;
       int slot = found < k ? found++ : k - 1;  // insertion sort into the sorted prefix
@@ -143,7 +156,10 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
 
 std::vector<Eigen::Vector3f> VoxelMap::points() const {
   std::vector<Eigen::Vector3f> all;
-  for (const auto& [key, bucket] : map_) all.insert(all.end(), bucket.begin(), bucket.end());
+  for (const auto& [key, bucket] : map_) {
+    const std::span<const Eigen::Vector3f> kept = points_of(bucket);
+    all.insert(all.end(), kept.begin(), kept.end());
+  }
   return all;
 }
 
@@ -153,7 +169,7 @@ std::vector<PointCovariance> VoxelMap::covariances() const {
     const auto it = covariances_.find(key);
     const std::size_t begin = all.size();
     if (it != covariances_.end()) all.insert(all.end(), it->second.begin(), it->second.end());
-    all.resize(begin + bucket.size());
+    all.resize(begin + bucket.count);
   }
   return all;
 }
@@ -164,7 +180,7 @@ std::vector<std::uint8_t> VoxelMap::sources() const {
     const auto it = sources_.find(key);
     const std::size_t begin = all.size();
     if (it != sources_.end()) all.insert(all.end(), it->second.begin(), it->second.end());
-    all.resize(begin + bucket.size(), kNoSource);
+    all.resize(begin + bucket.count, kNoSource);
   }
   return all;
 }

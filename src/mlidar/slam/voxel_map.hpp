@@ -78,7 +78,18 @@ class VoxelMap {
 
   double voxel_size_;
   int max_points_;
-  tsl::robin_map<VoxelKey, std::vector<Eigen::Vector3f>, VoxelKeyHash> map_;
+  /// A voxel's points: pool_[first, first + count).
+  struct Bucket {
+    std::uint32_t first = 0;
+    std::uint32_t count = 0;
+  };
+  std::span<const Eigen::Vector3f> points_of(const Bucket& bucket) const { return {pool_.data() + bucket.first, bucket.count}; }
+
+  tsl::robin_map<VoxelKey, Bucket, VoxelKeyHash> map_;
+  /// Every voxel's points in one array, max_points_ slots per voxel (a query reads a voxel's entry, then its
+  /// points: two reads, not three through a vector per voxel); slots of removed voxels are reused.
+  std::vector<Eigen::Vector3f> pool_;
+  std::vector<std::uint32_t> free_slots_;
   /// Per voxel, the covariances of its first points (a prefix of the bucket's; the rest are zero); only voxels
   /// that received a point with one.
   tsl::robin_map<VoxelKey, std::vector<PointCovariance>, VoxelKeyHash> covariances_;
