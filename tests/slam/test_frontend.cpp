@@ -61,6 +61,27 @@ TEST(RangeImage, ColumnIsTheNearestAzimuthBinClockwiseFromX) {
     }
 }
 
+TEST(Features, SelectSmallestPutsTheSmallestFirstAsASortWould) {
+  std::mt19937_64 rng(3);
+  for (int trial = 0; trial < 400; ++trial) {
+    const std::size_t size = rng() % 400;
+    // Distinct keys as extract_features makes them, and (every third trial) many equal ones.
+    const std::uint64_t range = trial % 3 == 2 ? 4 : ~0ULL;
+    std::vector<std::uint64_t> keys(size);
+    for (auto& key : keys) key = rng() % range;
+    const std::size_t count = size == 0 ? 0 : rng() % (size + 1);
+    std::vector<std::uint64_t> sorted = keys;
+    std::sort(sorted.begin(), sorted.end());
+    select_smallest(keys, count);
+    std::vector<std::uint64_t> first(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(count));
+    std::vector<std::uint64_t> rest(keys.begin() + static_cast<std::ptrdiff_t>(count), keys.end());
+    std::sort(first.begin(), first.end());
+    std::sort(rest.begin(), rest.end());
+    ASSERT_TRUE(std::equal(first.begin(), first.end(), sorted.begin())) << "trial " << trial << " size " << size << " count " << count;
+    ASSERT_TRUE(std::equal(rest.begin(), rest.end(), sorted.begin() + static_cast<std::ptrdiff_t>(count))) << "trial " << trial;
+  }
+}
+
 struct SegmentedScene {
   test::CastScan cast;
   RangeImage image;

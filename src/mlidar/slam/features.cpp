@@ -44,6 +44,38 @@ std::uint64_t candidate_key(float curvature, bool highest_first, std::uint32_t p
 
 std::uint32_t position_of(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xFFFFFFFFU); }
 
+}  // namespace
+
+void select_smallest(std::span<std::uint64_t> keys, std::size_t count) {
+  if (count >= keys.size()) return;
+  std::size_t lo = 0, hi = keys.size();  // the `count` smallest are keys[0, lo) and some of keys[lo, hi)
+  for (int round = 0; hi - lo > 16; ++round) {
+    if (round == 64) {  // not shrinking (many equal keys): the library's selection finishes
+      std::nth_element(keys.begin() + static_cast<std::ptrdiff_t>(lo), keys.begin() + static_cast<std::ptrdiff_t>(count),
+                       keys.begin() + static_cast<std::ptrdiff_t>(hi));
+      return;
+    }
+    const std::uint64_t a = keys[lo], b = keys[lo + (hi - lo) / 2], c = keys[hi - 1];
+    const std::uint64_t pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));  // median of three
+    std::size_t below = lo;                                                             // keys[lo, below) < pivot <= keys[below, i)
+    for (std::size_t i = lo; i < hi; ++i) {
+      const std::uint64_t key = keys[i];
+      keys[i] = keys[below];
+      keys[below] = key;
+      below += static_cast<std::size_t>(key < pivot);
+    }
+    if (below == count) return;
+    if (count < below) {
+      hi = below;
+    } else {
+      lo = below;  // unchanged only when nothing is below the pivot (equal keys): the round limit ends that
+    }
+  }
+  std::sort(keys.begin() + static_cast<std::ptrdiff_t>(lo), keys.begin() + static_cast<std::ptrdiff_t>(hi));
+}
+
+namespace {
+
 /// Calls visit(position) on `candidates` in key order until it returns true or
 /// they run out. Sorts lazily: a chunk (starting at 2 * wanted, doubling) is
 /// selected with nth_element and sorted only when the walk reaches it, since
@@ -55,7 +87,7 @@ void walk_in_order(std::vector<std::uint64_t>& candidates, int wanted, Visit vis
   auto chunk = static_cast<std::ptrdiff_t>(2 * wanted);
   while (first != candidates.end()) {
     const auto last = candidates.end() - first > chunk ? first + chunk : candidates.end();
-    if (last != candidates.end()) std::nth_element(first, last, candidates.end());
+    select_smallest({first, candidates.end()}, static_cast<std::size_t>(last - first));
     std::sort(first, last);
     for (; first != last; ++first)
       if (visit(position_of(*first))) return;

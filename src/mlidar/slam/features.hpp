@@ -50,6 +50,11 @@ struct FeatureWorkspace {
 /// the first and last 5 entries get +infinity (no full neighbourhood).
 void row_curvature(std::span<const float> ranges, std::span<float> curvature);
 
+/// Rearranges `keys` so that the first `count` are the `count` smallest (in no particular order), as
+/// std::nth_element does: quickselect with a median-of-three pivot and a partition without branches (the
+/// comparisons of noisy curvatures defeat branch prediction; std::nth_element was half of extract_features).
+void select_smallest(std::span<std::uint64_t> keys, std::size_t count);
+
 void extract_features(const RangeImage& image, const Segmentation& segmentation, const FeatureConfig& config, FeatureWorkspace& workspace,
                       FeatureIndices& out);
 
