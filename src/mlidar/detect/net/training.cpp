@@ -155,6 +155,12 @@ std::pair<double, std::uint64_t> draw_perturbation(bool inject, double share, co
   return {alpha, rng()};
 }
 
+/// Whether training draws perturbations (from stage2.alphas): not when the dataset's extrinsics are perturbed
+/// already (its own alpha), and not without levels to draw.
+bool draws_perturbations(const Session& session) {
+  return session.dataset.dataset_alpha() == 0.0 && !session.config.stage2.alphas.empty();
+}
+
 void train_stage1(Session& session) {
   const DetectConfig& config = session.config;
   const Fusion fusion = session.record.fusion;
@@ -162,7 +168,7 @@ void train_stage1(Session& session) {
   net::BevNet net = net::make_stage1(config);
   torch::optim::Adam optimizer(net->parameters(), torch::optim::AdamOptions(config.stage1.learning_rate).weight_decay(config.stage1.weight_decay));
   const long steps = stage_steps(session, config.stage1.epochs);
-  const bool inject = session.dataset.dataset_alpha() == 0.0 && !config.stage2.alphas.empty();
+  const bool inject = draws_perturbations(session);
   session.records[1] = run_loop(session, 1, *net, optimizer, config.stage1.learning_rate, steps, [&](long step) {
     std::mt19937_64 rng(mix_seed(mix_seed(config.seed, 1), static_cast<std::uint64_t>(step) + 1000003));
     // Stage 1 draws nothing unless asked to see perturbed frames (the thesis trains it on clean ones).
@@ -210,7 +216,7 @@ void train_stage2(Session& session) {
   net::Refiner refiner = net::make_stage2();
   torch::optim::Adam optimizer(refiner->parameters(), torch::optim::AdamOptions(config.stage2.learning_rate));
   const long steps = stage_steps(session, config.stage2.epochs);
-  const bool inject = session.dataset.dataset_alpha() == 0.0 && !config.stage2.alphas.empty();
+  const bool inject = draws_perturbations(session);
   session.records[2] = run_loop(session, 2, *refiner, optimizer, config.stage2.learning_rate, steps, [&](long step) {
     std::mt19937_64 rng(mix_seed(mix_seed(config.seed, 2), static_cast<std::uint64_t>(step) + 1000003));
     // 6.6.1.6: about 1 clean sample for 1.5 uncertain ones, each uncertain one at a level drawn from the alphas.
