@@ -135,6 +135,37 @@ TEST(SlamEstimator, InitializesCalibratesTrustsAndAShockSendsItBack) {
   EXPECT_EQ(reports[0].role, LidarRole::trusted);
 }
 
+TEST(SlamEstimator, FeatureSelectionWaitsUntilEveryLidarIsTrusted) {
+  // Greedy selection with online calibration: while the right LiDAR calibrates, the odometry registers every
+  // feature (frame for frame the run without selection), and selects from the frame after it is trusted.
+  constexpr std::size_t kFrames = 80;
+  const Drive drive = make_drive("rhd", "campus", "handheld", static_cast<int>(kFrames));
+  pipelines::SlamConfig config;
+  config.convergence.accepted_needed = 10;
+  pipelines::SlamConfig selecting = config;
+  selecting.odometry.registration.selection.method = slam::SelectionMethod::kGreedy;
+  SlamEstimator with(selecting, setups(drive.rig), ExtrinsicSource::online);
+  const auto scan_of = [&](std::size_t k, std::size_t i, const sim::SimLidar& lidar) { return std::optional(sweep(drive, lidar, k, i)); };
+  const std::vector<SlamFrame> frames = run(with, drive, scan_of);
+  const auto changes = role_changes(frames, 1, LidarRole::initializing);
+  ASSERT_GE(changes.size(), 2U);
+  ASSERT_EQ(changes[1].second, LidarRole::trusted);
+  const std::size_t trusted_from = changes[1].first + 1;  // the first frame registered with both LiDARs trusted
+  ASSERT_LT(trusted_from + 5, kFrames) << "the calibration should converge well inside the drive";
+  SlamEstimator without(config, setups(drive.rig), ExtrinsicSource::online);
+  for (std::size_t k = 0; k < kFrames; ++k) {
+    if (k < trusted_from) {
+      std::vector<std::optional<Scan>> scans;
+      for (std::size_t i = 0; i < drive.rig.lidars.size(); ++i) scans.push_back(scan_of(k, i, drive.rig.lidars[i]));
+      const SlamFrame plain = without.process(drive.stamps[k], scans);
+      EXPECT_EQ(frames[k].T_world_base.matrix(), plain.T_world_base.matrix()) << "frame " << k;
+      EXPECT_FALSE(frames[k].selection.has_value()) << "frame " << k;
+    } else {
+      EXPECT_TRUE(frames[k].selection.has_value()) << "frame " << k;
+    }
+  }
+}
+
 TEST(SlamEstimator, ALidarMissingForTenSecondsAddsNoMotionPairAcrossTheGap) {
   constexpr std::size_t kFrames = 130, kGapStart = 10, kGapEnd = 110;  // 100 frames at 10 Hz
   const Drive drive = make_drive("rhd", "campus", "handheld", static_cast<int>(kFrames));

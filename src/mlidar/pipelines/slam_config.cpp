@@ -217,6 +217,11 @@ std::vector<Field> selection_fields(SlamConfig& c) {
        {0.0, 100.0},
        "added to that bound (m); disagreeing, every feature is registered",
        &sel.held_out_residual_floor_m},
+      {"selection",
+       "while_calibrating",
+       {},
+       "select also while an extrinsic is calibrated online (else every feature until all LiDARs are trusted)",
+       &sel.while_calibrating},
   };
 }
 

@@ -109,6 +109,8 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   out.lidars.resize(tracks_.size());
   for (std::size_t j = 0; j < tracks_.size(); ++j) out.lidars[j].scan_missing = !scans[j].has_value();
   auto start = Clock::now();
+  const bool calibrating = std::any_of(tracks_.begin(), tracks_.end(), [](const LidarTrack& track) { return track.role() != LidarRole::trusted; });
+  odometry_->set_selection_paused(calibrating && !odometry_->config().registration.selection.while_calibrating);
   last_odometry_ = odometry_->process(trusted_frame(stamp, scans, trusted_));
   out.lost = last_odometry_.lost();
   out.suspect = last_odometry_.suspect();

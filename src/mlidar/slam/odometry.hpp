@@ -155,6 +155,9 @@ class Odometry {
   /// kept. Throws std::invalid_argument for no LiDARs.
   void set_lidars(std::vector<LidarSetup> lidars);
 
+  /// From the next frame on, registers on every feature (paused) or with the configured selection.
+  void set_selection_paused(bool paused) { selection_paused_ = paused; }
+
   const VoxelMap& plane_map() const { return plane_map_; }
   const VoxelMap& edge_map() const { return edge_map_; }
   const std::vector<LidarSetup>& lidars() const { return lidars_; }
@@ -215,6 +218,7 @@ class Odometry {
   RegistrationConfig registration_;                                     ///< this frame's (frame_registration)
   double degeneracy_stamp_ = -std::numeric_limits<double>::infinity();  ///< when lambda was last evaluated
   bool degenerate_scene_ = false;
+  bool selection_paused_ = false;
   double first_stamp_ = 0.0;
   double error_sq_sum_ = 0.0;
   std::size_t error_count_ = 0;
