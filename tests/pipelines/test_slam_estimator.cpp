@@ -136,8 +136,9 @@ TEST(SlamEstimator, InitializesCalibratesTrustsAndAShockSendsItBack) {
 }
 
 TEST(SlamEstimator, FeatureSelectionWaitsUntilEveryLidarIsTrusted) {
-  // Greedy selection with online calibration: while the right LiDAR calibrates, the odometry registers every
-  // feature (frame for frame the run without selection), and selects from the frame after it is trusted.
+  // Greedy selection with online calibration: while the right LiDAR calibrates, the odometry (and the right
+  // LiDAR's own, the hand-eye's input) registers every feature: frame for frame the run without selection, trusted
+  // at the same frame; it selects from the frame after.
   constexpr std::size_t kFrames = 80;
   const Drive drive = make_drive("rhd", "campus", "handheld", static_cast<int>(kFrames));
   pipelines::SlamConfig config;
@@ -159,6 +160,7 @@ TEST(SlamEstimator, FeatureSelectionWaitsUntilEveryLidarIsTrusted) {
       for (std::size_t i = 0; i < drive.rig.lidars.size(); ++i) scans.push_back(scan_of(k, i, drive.rig.lidars[i]));
       const SlamFrame plain = without.process(drive.stamps[k], scans);
       EXPECT_EQ(frames[k].T_world_base.matrix(), plain.T_world_base.matrix()) << "frame " << k;
+      EXPECT_EQ(frames[k].lidars[1].role, plain.lidars[1].role) << "frame " << k;  // trusted at the same frame
       EXPECT_FALSE(frames[k].selection.has_value()) << "frame " << k;
     } else {
       EXPECT_TRUE(frames[k].selection.has_value()) << "frame " << k;

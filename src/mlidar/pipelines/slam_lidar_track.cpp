@@ -123,7 +123,10 @@ LidarRole LidarTrack::role() const {
 }
 
 std::unique_ptr<slam::Odometry> LidarTrack::own_odometry() const {
-  return std::make_unique<slam::Odometry>(config_->odometry, std::vector{with_extrinsic(setup_, T_g_lidar_)});
+  auto own = std::make_unique<slam::Odometry>(config_->odometry, std::vector{with_extrinsic(setup_, T_g_lidar_)});
+  // Its poses are the hand-eye's input: every feature, as the trusted odometry's while calibrating.
+  own->set_selection_paused(!config_->odometry.registration.selection.while_calibrating);
+  return own;
 }
 
 LidarTrack::Initializing LidarTrack::start_initializing(bool own_odometry_now) {
