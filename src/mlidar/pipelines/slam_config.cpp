@@ -220,7 +220,7 @@ std::vector<Field> selection_fields(SlamConfig& c) {
       {"selection",
        "while_calibrating",
        {},
-       "select also while an extrinsic is calibrated online (else every feature until all LiDARs are trusted)",
+       "select also while an extrinsic is calibrated (online or refine; else every feature until all LiDARs are trusted)",
        &sel.while_calibrating},
   };
 }
