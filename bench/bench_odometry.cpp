@@ -113,6 +113,21 @@ void BM_DeskewAllPoints(benchmark::State& state) {
 }
 BENCHMARK(BM_DeskewAllPoints)->Unit(benchmark::kMillisecond);
 
+/// The features of all LiDARs of frame k (base frame, deskewed).
+LidarFeatures frame_features(const Sequence& data, std::size_t k) {
+  const OdometryConfig config;
+  LidarFeatures all;
+  for (std::size_t i = 0; i < data.lidars.size(); ++i) {
+    FrontEndWorkspace ws;
+    LidarFeatures one;
+    StageSeconds seconds{};
+    run_front_end(data.frames[k].scans[i], data.frames[k].stamp, data.lidars[i], {}, config.front_end, ws, one, seconds);
+    all.edges.insert(all.edges.end(), one.edges.begin(), one.edges.end());
+    all.planes.insert(all.planes.end(), one.planes.begin(), one.planes.end());
+  }
+  return all;
+}
+
 /// Frame 1's features of all LiDARs and the maps of frame 0's.
 struct RegistrationCase {
   LidarFeatures features;
@@ -125,40 +140,14 @@ const RegistrationCase& registration_case() {
   static const RegistrationCase built = [] {
     const Sequence& data = sequence();
     const OdometryConfig config;
-    std::vector<LidarFeatures> features(2);
-    for (int k = 0; k < 2; ++k) {
-      for (std::size_t i = 0; i < data.lidars.size(); ++i) {
-        FrontEndWorkspace ws;
-        LidarFeatures one;
-        StageSeconds seconds{};
-        run_front_end(data.frames[static_cast<std::size_t>(k)].scans[i], data.frames[static_cast<std::size_t>(k)].stamp, data.lidars[i], {},
-                      config.front_end, ws, one, seconds);
-        auto& all = features[static_cast<std::size_t>(k)];
-        all.edges.insert(all.edges.end(), one.edges.begin(), one.edges.end());
-        all.planes.insert(all.planes.end(), one.planes.begin(), one.planes.end());
-      }
-    }
-    RegistrationCase out{features[1], VoxelMap(config.edge_voxel_m, config.edge_points_per_voxel),
+    const LidarFeatures map_features = frame_features(data, 0);
+    RegistrationCase out{frame_features(data, 1), VoxelMap(config.edge_voxel_m, config.edge_points_per_voxel),
                          VoxelMap(config.plane_voxel_m, config.plane_points_per_voxel)};
-    out.edge_map.add(features[0].edges);
-    out.plane_map.add(features[0].planes);
+    out.edge_map.add(map_features.edges);
+    out.plane_map.add(map_features.planes);
     return out;
   }();
   return built;
-}
-
-/// The features of all LiDARs of frame k (base frame, deskewed).
-LidarFeatures frame_features(const Sequence& data, std::size_t k) {
-  const OdometryConfig config;
-  LidarFeatures all;
-  for (std::size_t i = 0; i < data.lidars.size(); ++i) {
-    FrontEndWorkspace ws;
-    LidarFeatures one;
-    StageSeconds seconds{};
-    run_front_end(data.frames[k].scans[i], data.frames[k].stamp, data.lidars[i], {}, config.front_end, ws, one, seconds);
-    all.planes.insert(all.planes.end(), one.planes.begin(), one.planes.end());
-  }
-  return all;
 }
 
 /// The map-neighbour search of scan-to-map registration: the last frame's plane features (all LiDARs, at the true

@@ -109,7 +109,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   out.lidars.resize(tracks_.size());
   for (std::size_t j = 0; j < tracks_.size(); ++j) out.lidars[j].scan_missing = !scans[j].has_value();
   auto start = Clock::now();
-  const bool calibrating = std::any_of(tracks_.begin(), tracks_.end(), [](const LidarTrack& track) { return track.role() != LidarRole::trusted; });
+  const bool calibrating = trusted_.size() < tracks_.size();  // some LiDAR is not registered by the odometry yet
   odometry_->set_selection_paused(calibrating && !odometry_->config().registration.selection.while_calibrating);
   last_odometry_ = odometry_->process(trusted_frame(stamp, scans, trusted_));
   out.lost = last_odometry_.lost();

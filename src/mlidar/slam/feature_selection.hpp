@@ -79,8 +79,8 @@ struct SelectionConfig {
   double held_out_share = 0.25;
   double held_out_residual_ratio = 1.5;
   double held_out_residual_floor_m = 0.01;
-  /// Read by the SLAM estimator: whether the odometry selects while an extrinsic is being calibrated online
-  /// (its poses and map are the calibration's input; selecting there made convergence 26 % later on campus).
+  /// Read by the SLAM estimator: whether the odometries select while an extrinsic is being calibrated (online or
+  /// refine; their poses and map are the calibration's input: selecting there made convergence 26 % later on campus).
   bool while_calibrating = false;
 };
 

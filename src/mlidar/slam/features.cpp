@@ -44,6 +44,25 @@ std::uint64_t candidate_key(float curvature, bool highest_first, std::uint32_t p
 
 std::uint32_t position_of(std::uint64_t key) { return static_cast<std::uint32_t>(key & 0xFFFFFFFFU); }
 
+/// Calls visit(position) on `candidates` in key order until it returns true or
+/// they run out. Sorts lazily: a chunk (starting at 2 * wanted, doubling) is
+/// selected (select_smallest) and sorted only when the walk reaches it, since
+/// most picks end within the first few (a full sort per sector was 8 % of slam).
+template <typename Visit>
+void walk_in_order(std::vector<std::uint64_t>& candidates, int wanted, Visit visit) {
+  if (wanted <= 0) return;
+  auto first = candidates.begin();
+  auto chunk = static_cast<std::ptrdiff_t>(2 * wanted);
+  while (first != candidates.end()) {
+    const auto last = candidates.end() - first > chunk ? first + chunk : candidates.end();
+    select_smallest({first, candidates.end()}, static_cast<std::size_t>(last - first));
+    std::sort(first, last);
+    for (; first != last; ++first)
+      if (visit(position_of(*first))) return;
+    chunk *= 2;
+  }
+}
+
 }  // namespace
 
 void select_smallest(std::span<std::uint64_t> keys, std::size_t count) {
@@ -73,29 +92,6 @@ void select_smallest(std::span<std::uint64_t> keys, std::size_t count) {
   }
   std::sort(keys.begin() + static_cast<std::ptrdiff_t>(lo), keys.begin() + static_cast<std::ptrdiff_t>(hi));
 }
-
-namespace {
-
-/// Calls visit(position) on `candidates` in key order until it returns true or
-/// they run out. Sorts lazily: a chunk (starting at 2 * wanted, doubling) is
-/// selected with nth_element and sorted only when the walk reaches it, since
-/// most picks end within the first few (a full sort per sector was 8 % of slam).
-template <typename Visit>
-void walk_in_order(std::vector<std::uint64_t>& candidates, int wanted, Visit visit) {
-  if (wanted <= 0) return;
-  auto first = candidates.begin();
-  auto chunk = static_cast<std::ptrdiff_t>(2 * wanted);
-  while (first != candidates.end()) {
-    const auto last = candidates.end() - first > chunk ? first + chunk : candidates.end();
-    select_smallest({first, candidates.end()}, static_cast<std::size_t>(last - first));
-    std::sort(first, last);
-    for (; first != last; ++first)
-      if (visit(position_of(*first))) return;
-    chunk *= 2;
-  }
-}
-
-}  // namespace
 
 void row_curvature(std::span<const float> ranges, std::span<float> curvature) {
   const int n = static_cast<int>(ranges.size());

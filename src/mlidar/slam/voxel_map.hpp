@@ -86,8 +86,8 @@ class VoxelMap {
   std::span<const Eigen::Vector3f> points_of(const Bucket& bucket) const { return {pool_.data() + bucket.first, bucket.count}; }
 
   tsl::robin_map<VoxelKey, Bucket, VoxelKeyHash> map_;
-  /// Every voxel's points in one array, max_points_ slots per voxel (a query reads a voxel's entry, then its
-  /// points: two reads, not three through a vector per voxel); slots of removed voxels are reused.
+  /// Every voxel's points in one array, max_points_ slots per voxel (no allocation per new voxel); slots of removed
+  /// voxels are reused.
   std::vector<Eigen::Vector3f> pool_;
   std::vector<std::uint32_t> free_slots_;
   /// Per voxel, the covariances of its first points (a prefix of the bucket's; the rest are zero); only voxels
