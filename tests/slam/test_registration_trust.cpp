@@ -3,6 +3,7 @@
 // and ambiguity between distinct alignments.
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -85,6 +86,44 @@ TEST(ChooseRegistration, AnAlignmentElsewhereThatFitsAsWellMakesItAmbiguous) {
   // Clearly worse elsewhere (0.076 vs 0.051 m: BALM 110 -> 112): the best is unique.
   const std::vector<slam::RegistrationResult> clear = {candidate(0.076, 0.9, moved(2.1)), candidate(0.051, 0.9)};
   EXPECT_EQ(slam::choose_registration(clear, rule).trust, slam::Trust::kTrusted);
+}
+
+// The retries refine a coarse end pose unless it converged to a fit no
+// registration may keep; the tightest always, converged or not.
+TEST(RefinablePoses, DropsConvergedFitsAboveTheAcceptableBoundButNeverTheTightest) {
+  const auto coarse = [](double mean_residual_m, bool converged, double x_m) {
+    slam::RegistrationResult r = candidate(mean_residual_m, 0.9, moved(x_m));
+    r.converged = converged;
+    return r;
+  };
+  const std::vector<slam::RegistrationResult> results = {
+      coarse(0.30, true, 1.0),   // a local minimum that fits badly: dropped
+      coarse(0.06, true, 2.0),   // kept
+      coarse(0.35, false, 3.0),  // still moving: kept
+      coarse(0.20, true, 4.0),   // on the bound: kept
+  };
+  const std::vector<SE3> kept = slam::refinable_poses(results, 0.2);
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_DOUBLE_EQ(kept[0].translation().x(), 2.0);
+  EXPECT_DOUBLE_EQ(kept[1].translation().x(), 3.0);
+  EXPECT_DOUBLE_EQ(kept[2].translation().x(), 4.0);
+  // All converged badly: the tightest still runs, so the frame is judged, not dropped unseen.
+  const std::vector<slam::RegistrationResult> bad = {coarse(0.4, true, 1.0), coarse(0.3, true, 2.0), coarse(0.5, true, 3.0)};
+  const std::vector<SE3> tightest = slam::refinable_poses(bad, 0.2);
+  ASSERT_EQ(tightest.size(), 1u);
+  EXPECT_DOUBLE_EQ(tightest[0].translation().x(), 2.0);
+  EXPECT_THROW(slam::refinable_poses({}, 0.2), std::invalid_argument);
+}
+
+TEST(DistinctPoses, KeepsTheFirstOfEachAlignmentReachedTwice) {
+  const std::vector<SE3> poses = {moved(0.0), moved(0.04), moved(0.0, 0.4), moved(0.06), moved(0.0, 0.6), moved(0.0), moved(0.03, 0.3)};
+  const std::vector<SE3> kept = slam::distinct_poses(poses, 0.05, 0.5);
+  // 0.04 m and 0.4 deg from the first are the same; 0.06 m and 0.6 deg are not (either bound decides).
+  ASSERT_EQ(kept.size(), 3u);
+  EXPECT_DOUBLE_EQ(kept[0].translation().x(), 0.0);
+  EXPECT_DOUBLE_EQ(kept[1].translation().x(), 0.06);
+  EXPECT_NEAR(so3_log(kept[2].rotation()).z() * 180.0 / std::numbers::pi, 0.6, 1e-9);
+  EXPECT_TRUE(slam::distinct_poses({}, 0.05, 0.5).empty());
 }
 
 // A degenerate registration may hold the weak direction at its start but not

@@ -41,6 +41,33 @@ double mean_point_time(const Frame& frame) {
   return count == 0 ? 0.0 : sum / static_cast<double>(count);
 }
 
+/// Every n-th edge and plane of a frame (and their covariances, when given): the retries' coarse pass.
+struct StridedFeatures {
+  std::vector<Eigen::Vector3f> edges, planes;
+  std::vector<PointCovariance> edge_covariances, plane_covariances;
+  std::optional<QueryCovariances> query;
+
+  StridedFeatures(const LidarFeatures& features, const QueryCovariances* covariances, std::size_t stride)
+      : edges(every_nth(std::span<const Eigen::Vector3f>(features.edges), stride)),
+        planes(every_nth(std::span<const Eigen::Vector3f>(features.planes), stride)) {
+    if (covariances == nullptr) return;
+    edge_covariances = every_nth(covariances->edges, stride);
+    plane_covariances = every_nth(covariances->planes, stride);
+    query = QueryCovariances{edge_covariances, plane_covariances, covariances->residual_sigma_m};
+  }
+  StridedFeatures(const StridedFeatures&) = delete;  // `query` points into this object's vectors
+  StridedFeatures& operator=(const StridedFeatures&) = delete;
+  const QueryCovariances* covariances() const { return query ? &*query : nullptr; }
+
+  template <typename T>
+  static std::vector<T> every_nth(std::span<const T> values, std::size_t stride) {
+    std::vector<T> out;
+    out.reserve(values.size() / std::max<std::size_t>(stride, 1) + 1);
+    for (std::size_t i = 0; i < values.size(); i += std::max<std::size_t>(stride, 1)) out.push_back(values[i]);
+    return out;
+  }
+};
+
 /// Appends one LiDAR's features; a LiDAR without times gets time 0 (no motion) so times stay aligned with points.
 void append_features(const LidarFeatures& from, LidarFeatures& to) {
   to.edges.insert(to.edges.end(), from.edges.begin(), from.edges.end());
@@ -324,16 +351,26 @@ void Odometry::add_retries(const SE3& prediction, double threshold, const Motion
   // was not trusted, where a selection made at a poor start is least reliable.
   RegistrationConfig every_feature = registration_;
   every_feature.selection.method = SelectionMethod::kNone;
+  // A coarse pass from each start with the initial (wide) threshold on every n-th feature ...
+  RegistrationConfig coarse_config = every_feature;
+  coarse_config.max_iterations = config_.retry_coarse_iterations;
+  coarse_config.convergence_translation_m = config_.retry_coarse_convergence_m;
+  coarse_config.convergence_rotation_rad = config_.retry_coarse_convergence_rad;
+  const StridedFeatures sparse(frame_features_, query_covariances(), config_.retry_coarse_stride);
+  std::vector<RegistrationResult> coarse(starts.size());
   // Independent of each other (the maps are only read), so in parallel; each lands in its own slot.
-  const std::size_t first = out.size();
-  out.resize(first + starts.size());
   tbb::parallel_for(std::size_t{0}, starts.size(), [&](std::size_t i) {
-    // A coarse pass with the initial (wide) threshold, then a fine pass.
-    const RegistrationResult coarse =
-        register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, starts[i],
-                             std::max(threshold, config_.initial_threshold_m), every_feature, nullptr, query_covariances());
-    out[first + i] = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, coarse.T_world_base,
-                                          threshold, every_feature, motion, query_covariances());
+    coarse[i] = register_scan_to_map(sparse.edges, sparse.planes, edge_map_, plane_map_, starts[i],
+                                     std::max(threshold, config_.initial_threshold_m), coarse_config, nullptr, sparse.covariances());
+  });
+  // ... then a fine pass on every feature from each distinct coarse end pose that may still fit.
+  const std::vector<SE3> distinct = distinct_poses(refinable_poses(coarse, config_.trust.max_mean_residual_m),
+                                                   config_.retry_same_translation_m, config_.retry_same_rotation_deg);
+  const std::size_t first = out.size();
+  out.resize(first + distinct.size());
+  tbb::parallel_for(std::size_t{0}, distinct.size(), [&](std::size_t i) {
+    out[first + i] = register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, distinct[i], threshold,
+                                          every_feature, motion, query_covariances());
   });
 }
 

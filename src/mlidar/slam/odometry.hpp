@@ -63,6 +63,22 @@ struct OdometryConfig {
   /// same yaws: after a second of handheld motion the constant-velocity
   /// prediction can be metres off.
   bool retry_from_previous_pose = true;
+  /// The retries' coarse pass (from each start, at the wide threshold) uses
+  /// every n-th feature and stops at a looser convergence (it only seeds the
+  /// fine pass); the fine pass on every feature then runs from each distinct
+  /// coarse end pose, except those that converged to a fit no registration may
+  /// have (mean |r| above trust.max_mean_residual_m; the best one always runs).
+  /// Real BALM keyframes, 10 retried frames: 34 full registrations each
+  /// before, 23.8 s of a 26.7 s run; after, 1-2 fine passes per frame, the
+  /// same pair errors (docs/benchmarks.md "Cheaper retries"). 1: every feature.
+  std::size_t retry_coarse_stride = 8;
+  int retry_coarse_iterations = 100;
+  double retry_coarse_convergence_m = 0.01;
+  double retry_coarse_convergence_rad = 1e-3;
+  /// Coarse end poses closer than this (both) are the same: a quarter of what
+  /// makes two alignments distinct rivals (TrustConfig::distinct_*).
+  double retry_same_translation_m = 0.05;
+  double retry_same_rotation_deg = 0.5;
   /// Frames this long after the previous one (seconds) always run the retries
   /// and are judged with their rivals, trusted first registration or not.
   double always_retry_after_s = 1.5;

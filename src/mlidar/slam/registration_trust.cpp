@@ -83,6 +83,27 @@ Choice choose_registration(std::span<const RegistrationResult> candidates, const
   return choice;
 }
 
+std::vector<SE3> refinable_poses(std::span<const RegistrationResult> coarse, double max_mean_residual_m) {
+  if (coarse.empty()) throw std::invalid_argument("refinable_poses: no registrations");
+  const auto tightest = std::min_element(coarse.begin(), coarse.end(), [](const RegistrationResult& a, const RegistrationResult& b) {
+    return a.mean_residual_m < b.mean_residual_m;
+  });
+  std::vector<SE3> kept;
+  for (auto r = coarse.begin(); r != coarse.end(); ++r)
+    if (r == tightest || !r->converged || r->mean_residual_m <= max_mean_residual_m) kept.push_back(r->T_world_base);
+  return kept;
+}
+
+std::vector<SE3> distinct_poses(std::span<const SE3> poses, double translation_m, double rotation_deg) {
+  std::vector<SE3> kept;
+  for (const SE3& pose : poses) {
+    const bool seen = std::any_of(kept.begin(), kept.end(),
+                                  [&](const SE3& k) { return !farther_than(k, pose, translation_m, rotation_deg); });
+    if (!seen) kept.push_back(pose);
+  }
+  return kept;
+}
+
 Trust judge_degenerate_correction(Trust trust, const RegistrationResult& r, const SE3& prediction, const TrustConfig& config) {
   if (trust != Trust::kTrusted || !r.degenerate) return trust;
   return farther_than(prediction, r.T_world_base, config.degenerate_max_correction_m, config.degenerate_max_correction_deg)

@@ -14,6 +14,7 @@
 #include <deque>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "mlidar/slam/scan_to_map.hpp"
 
@@ -87,6 +88,16 @@ struct Choice {
 /// Keeps the acceptable candidate with the smallest mean |r| (the first one
 /// when none is acceptable) and judges it. Candidates must not be empty.
 Choice choose_registration(std::span<const RegistrationResult> candidates, const TrustRule& rule);
+
+/// The end poses of coarse registrations worth refining, in order: all but
+/// those that converged with a mean |r| above `max_mean_residual_m` (a fit no
+/// registration may keep, at a local minimum); the one with the smallest mean
+/// |r| always. Candidates must not be empty.
+std::vector<SE3> refinable_poses(std::span<const RegistrationResult> coarse, double max_mean_residual_m);
+
+/// The poses in order, each left out when it lies within both `translation_m`
+/// and `rotation_deg` of one kept before it (the same alignment reached twice).
+std::vector<SE3> distinct_poses(std::span<const SE3> poses, double translation_m, double rotation_deg);
 
 /// kDegenerate when `trust` is kTrusted but the registration is degenerate and
 /// moved farther from `prediction` than TrustConfig allows; `trust` otherwise.
