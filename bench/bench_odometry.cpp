@@ -1,17 +1,22 @@
 // Odometry hot paths on simulated rv/campus scans (seeded): each front-end
 // stage on the top LiDAR, one scan-to-map registration, and whole frames with
-// 1-4 of the rv rig's LiDARs (issue 7's scaling, thesis Table 4.7).
+// 1-4 of the rv rig's LiDARs (issue 7's scaling, thesis Table 4.7); the scan
+// rows of real ring-less keyframes.
 #include <algorithm>
 #include <array>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "mlidar/io/cloud_file.hpp"
 #include "mlidar/sim/acquisition.hpp"
 #include "mlidar/sim/rig.hpp"
 #include "mlidar/sim/scenes.hpp"
 #include "mlidar/sim/trajectory.hpp"
 #include "mlidar/slam/odometry.hpp"
+#include "mlidar/slam/row_recovery.hpp"
 
 namespace mlidar::slam {
 namespace {
@@ -59,6 +64,28 @@ void BM_RangeImage(benchmark::State& state) {
   state.counters["points"] = static_cast<double>(scan.size());
 }
 BENCHMARK(BM_RangeImage)->Unit(benchmark::kMillisecond);
+
+// Scan rows recovered from a real ring-less Ouster keyframe (BALM, ~75k
+// points): arg = keyframe; 20 is a single sweep (64 rows recovered), 60 merged
+// from sweeps taken while moving (refused after the same search).
+void BM_RecoverRows(benchmark::State& state) {
+  const std::filesystem::path file = std::filesystem::path(MLIDAR_SHARED_DATA) / "real" / "balm_ouster" / "frames" /
+                                     ("full" + std::to_string(state.range(0)) + ".pcd");
+  if (!std::filesystem::exists(file)) {
+    state.SkipWithError("shared data not found");
+    return;
+  }
+  const std::vector<Eigen::Vector3f> points = io::to_scan(io::read_cloud(file).table, file.string()).points;
+  bool recovered = false;
+  for (auto _ : state) {
+    const auto rows = recover_rows(points);
+    recovered = rows.has_value();
+    benchmark::DoNotOptimize(rows);
+  }
+  state.counters["points"] = static_cast<double>(points.size());
+  state.counters["recovered"] = recovered ? 1.0 : 0.0;
+}
+BENCHMARK(BM_RecoverRows)->Arg(20)->Arg(60)->Unit(benchmark::kMillisecond);
 
 void BM_Segmentation(benchmark::State& state) {
   const Sequence& data = sequence();

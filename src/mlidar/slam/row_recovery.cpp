@@ -1,6 +1,7 @@
 #include "mlidar/slam/row_recovery.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -73,6 +74,55 @@ std::vector<double> smoothed(std::vector<double> counts) {
   return counts;
 }
 
+/// One sector's smoothed elevation histogram, held only over [first, first + counts.size()):
+/// the bins of its points and two beyond on each side (the two smoothing passes spread that far).
+struct SectorHistogram {
+  int first = 0;
+  std::vector<double> counts;
+  bool empty() const { return counts.empty(); }
+  int last() const { return first + static_cast<int>(counts.size()) - 1; }
+  double at(int bin) const { return counts[static_cast<std::size_t>(bin - first)]; }
+};
+
+/// Every sector's histogram: the bins of its points counted, then smoothed as `smoothed` does
+/// (outside the held range every bin is zero, so the values are the same).
+std::vector<SectorHistogram> sector_histograms(const std::vector<int>& bins, const UsablePoints& usable, const Histograms& h) {
+  const auto sectors = static_cast<std::size_t>(h.sectors());
+  std::vector<int> lo(sectors, h.bins()), hi(sectors, -1);
+  for (std::size_t k = 0; k < bins.size(); ++k) {
+    lo[usable.sector[k]] = std::min(lo[usable.sector[k]], bins[k]);
+    hi[usable.sector[k]] = std::max(hi[usable.sector[k]], bins[k]);
+  }
+  std::vector<SectorHistogram> histogram(sectors);
+  for (std::size_t s = 0; s < sectors; ++s) {
+    if (hi[s] < 0) continue;
+    histogram[s].first = std::max(0, lo[s] - 2);
+    histogram[s].counts.assign(static_cast<std::size_t>(std::min(h.bins() - 1, hi[s] + 2) - histogram[s].first + 1), 0.0);
+  }
+  for (std::size_t k = 0; k < bins.size(); ++k) {
+    SectorHistogram& sector = histogram[usable.sector[k]];
+    sector.counts[static_cast<std::size_t>(bins[k] - sector.first)] += 1.0;
+  }
+  for (SectorHistogram& sector : histogram)
+    if (!sector.empty()) sector.counts = smoothed(std::move(sector.counts));
+  return histogram;
+}
+
+/// Sum over the sector's bins a of histogram(a) x templ(a - shift). Every value is a
+/// multiple of 1/16 (counts smoothed by [1 4 6 4 1] / 16, and sums of those), so each
+/// product and every partial sum is exact in a double (far below 2^45 x 1/256 here):
+/// four running sums give the same score as one, without one long chain of additions.
+double correlation(const SectorHistogram& sector, const std::vector<double>& templ, int shift) {
+  const int begin = std::max(sector.first, shift), end = std::min(sector.last(), static_cast<int>(templ.size()) - 1 + shift) + 1;
+  std::array<double, 4> sums{};
+  int a = begin;
+  for (; a + 4 <= end; a += 4)
+    for (int lane = 0; lane < 4; ++lane)
+      sums[static_cast<std::size_t>(lane)] += sector.at(a + lane) * templ[static_cast<std::size_t>(a + lane - shift)];
+  for (; a < end; ++a) sums[0] += sector.at(a) * templ[static_cast<std::size_t>(a - shift)];
+  return (sums[0] + sums[1]) + (sums[2] + sums[3]);
+}
+
 /// Per sector, the bin shift that maps its beams onto those of the sectors
 /// before it: each sector's smoothed histogram cross-correlated with the sum
 /// of the last few sectors' corrected ones (a template, so steps smaller than
@@ -81,39 +131,24 @@ std::vector<double> smoothed(std::vector<double> counts) {
 std::vector<int> sector_shifts(const std::vector<int>& bins, const UsablePoints& usable, const Histograms& h, int max_step) {
   constexpr std::size_t kTemplateSectors = 6;
   const auto sectors = static_cast<std::size_t>(h.sectors());
-  const auto bin_count = static_cast<std::size_t>(h.bins());
-  std::vector<std::vector<double>> histogram(sectors, std::vector<double>(bin_count, 0.0));
-  std::vector<int> lo(sectors, h.bins()), hi(sectors, -1);
-  for (std::size_t k = 0; k < bins.size(); ++k) {
-    const std::size_t s = usable.sector[k];
-    histogram[s][static_cast<std::size_t>(bins[k])] += 1.0;
-    lo[s] = std::min(lo[s], bins[k]);
-    hi[s] = std::max(hi[s], bins[k]);
-  }
-  for (auto& counts : histogram) counts = smoothed(std::move(counts));
+  const std::vector<SectorHistogram> histogram = sector_histograms(bins, usable, h);
   // The template: the last kTemplateSectors non-empty sectors' histograms, in corrected bins.
-  std::vector<double> templ(bin_count, 0.0);
+  std::vector<double> templ(static_cast<std::size_t>(h.bins()), 0.0);
   const auto add_to_template = [&](std::size_t sector, double sign, int offset) {
-    for (int bin = std::max(0, lo[sector] - 2); bin <= std::min(h.bins() - 1, hi[sector] + 2); ++bin) {  // smoothing spreads 2 bins
+    for (int bin = histogram[sector].first; bin <= histogram[sector].last(); ++bin) {
       const int corrected = bin - offset;
-      if (corrected >= 0 && corrected < h.bins())
-        templ[static_cast<std::size_t>(corrected)] += sign * histogram[sector][static_cast<std::size_t>(bin)];
+      if (corrected >= 0 && corrected < h.bins()) templ[static_cast<std::size_t>(corrected)] += sign * histogram[sector].at(bin);
     }
   };
   std::vector<int> shift(sectors, 0);
   std::vector<std::size_t> matched;  // non-empty sectors so far
   int current = 0;
   for (std::size_t s = 0; s < sectors; ++s) {
-    if (hi[s] >= 0 && !matched.empty()) {
+    if (!histogram[s].empty() && !matched.empty()) {
       double best = -1.0;
       int best_shift = current;
       for (int candidate = current - max_step; candidate <= current + max_step; ++candidate) {
-        double score = 0.0;
-        for (int a = std::max(0, lo[s] - 2); a <= std::min(h.bins() - 1, hi[s] + 2); ++a) {
-          const int corrected = a - candidate;
-          if (corrected >= 0 && corrected < h.bins())
-            score += histogram[s][static_cast<std::size_t>(a)] * templ[static_cast<std::size_t>(corrected)];
-        }
+        const double score = correlation(histogram[s], templ, candidate);
         // Ties go to the smaller step.
         if (score > best + 1e-9 || (std::abs(score - best) <= 1e-9 && std::abs(candidate - current) < std::abs(best_shift - current))) {
           best = score;
@@ -123,7 +158,7 @@ std::vector<int> sector_shifts(const std::vector<int>& bins, const UsablePoints&
       current = best_shift;
     }
     shift[s] = current;
-    if (hi[s] < 0) continue;
+    if (histogram[s].empty()) continue;
     matched.push_back(s);
     add_to_template(s, 1.0, current);
     if (matched.size() > kTemplateSectors) {
@@ -258,12 +293,16 @@ std::optional<RecoveredRows> recover_rows(std::span<const Eigen::Vector3f> point
   const std::vector<int> bounds = row_bounds(s, peaks);
   const std::size_t rows = peaks.size();
 
+  // The row of each corrected bin in [bounds.front(), bounds.back()).
+  std::vector<std::size_t> row_of_bin(static_cast<std::size_t>(bounds.back() - bounds.front()));
+  for (std::size_t row = 0; row < rows; ++row)
+    for (int bin = bounds[row]; bin < bounds[row + 1]; ++bin) row_of_bin[static_cast<std::size_t>(bin - bounds.front())] = row;
   std::vector<int> point_row(usable.index.size(), -1);
   std::vector<std::vector<double>> row_elevations(rows);
   for (std::size_t k = 0; k < point_row.size(); ++k) {
     const int corrected = bins[k] - shift[usable.sector[k]];
     if (corrected < bounds.front() || corrected >= bounds.back()) continue;
-    const auto row = static_cast<std::size_t>(std::upper_bound(bounds.begin(), bounds.end(), corrected) - bounds.begin() - 1);
+    const std::size_t row = row_of_bin[static_cast<std::size_t>(corrected - bounds.front())];
     point_row[k] = static_cast<int>(row);
     row_elevations[row].push_back(h.centre_deg(corrected));
   }
