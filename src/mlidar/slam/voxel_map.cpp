@@ -95,6 +95,14 @@ constexpr std::array<Sides, 26> kNeighbourSides = [] {
   return order;
 }();
 
+/// The neighbours before this index in kNeighbourSides have no far side.
+constexpr std::size_t kFirstWithFarSide = [] {
+  std::size_t i = 0;
+  while (i < kNeighbourSides.size() && kNeighbourSides[i][0] != 2 && kNeighbourSides[i][1] != 2 && kNeighbourSides[i][2] != 2) ++i;
+  return i;
+}();
+static_assert(kFirstWithFarSide == 7);
+
 /// One axis of a query's position in its voxel: per side (same, near, far) the voxel offset and the squared gap
 /// to that layer's box.
 struct AxisLayers {
@@ -146,8 +154,14 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
   const AxisLayers x = axis_layers(fraction_of(q.x(), center.x), size);
   const AxisLayers y = axis_layers(fraction_of(q.y(), center.y), size);
   const AxisLayers z = axis_layers(fraction_of(q.z(), center.z), size);
-  for (const auto& [sx, sy, sz] : kNeighbourSides) {
-    const float bound = (x.gap_sq[sx] + y.gap_sq[sy] + z.gap_sq[sz]) * 0.999F - 1e-6F;
+  const auto shrunk = [](float gap_sq) { return gap_sq * 0.999F - 1e-6F; };
+  // From kFirstWithFarSide on every box has a far side, so its bound is at least the smallest far gap's (float
+  // sums of non-negative gaps and the shrink are monotone): when that bound is skipped, all of them are.
+  const float far_bound = shrunk(std::min({x.gap_sq[2], y.gap_sq[2], z.gap_sq[2]}));
+  for (std::size_t i = 0; i < kNeighbourSides.size(); ++i) {
+    if (i == kFirstWithFarSide && (far_bound > max_distance_sq || (found == k && far_bound >= best_sq[kth]))) break;
+    const auto& [sx, sy, sz] = kNeighbourSides[i];
+    const float bound = shrunk(x.gap_sq[sx] + y.gap_sq[sy] + z.gap_sq[sz]);
     if (bound > max_distance_sq || (found == k && bound >= best_sq[kth])) continue;
     visit({center.x + x.offset[sx], center.y + y.offset[sy], center.z + z.offset[sz]});
   }
