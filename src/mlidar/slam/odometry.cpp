@@ -61,9 +61,10 @@ struct StridedFeatures {
 
   template <typename T>
   static std::vector<T> every_nth(std::span<const T> values, std::size_t stride) {
+    const std::size_t step = std::max<std::size_t>(stride, 1);
     std::vector<T> out;
-    out.reserve(values.size() / std::max<std::size_t>(stride, 1) + 1);
-    for (std::size_t i = 0; i < values.size(); i += std::max<std::size_t>(stride, 1)) out.push_back(values[i]);
+    out.reserve(values.size() / step + 1);
+    for (std::size_t i = 0; i < values.size(); i += step) out.push_back(values[i]);
     return out;
   }
 };
@@ -365,7 +366,7 @@ void Odometry::add_retries(const SE3& prediction, double threshold, const Motion
   });
   // ... then a fine pass on every feature from each distinct coarse end pose that may still fit.
   const std::vector<SE3> distinct = distinct_poses(refinable_poses(coarse, config_.trust.max_mean_residual_m),
-                                                   config_.retry_same_translation_m, config_.retry_same_rotation_deg);
+                                                   0.25 * config_.trust.distinct_translation_m, 0.25 * config_.trust.distinct_rotation_deg);
   const std::size_t first = out.size();
   out.resize(first + distinct.size());
   tbb::parallel_for(std::size_t{0}, distinct.size(), [&](std::size_t i) {

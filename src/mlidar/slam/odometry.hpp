@@ -66,7 +66,8 @@ struct OdometryConfig {
   /// The retries' coarse pass (from each start, at the wide threshold) uses
   /// every n-th feature and stops at a looser convergence (it only seeds the
   /// fine pass); the fine pass on every feature then runs from each distinct
-  /// coarse end pose, except those that converged to a fit no registration may
+  /// coarse end pose (closer than a quarter of trust.distinct_* in both
+  /// translation and rotation counts as the same: 0.05 m and 0.5 deg), except those that converged to a fit no registration may
   /// have (mean |r| above trust.max_mean_residual_m; the best one always runs).
   /// Real BALM keyframes, 10 retried frames: 34 full registrations each
   /// before, 23.8 s of a 26.7 s run; after, 1-2 fine passes per frame, the
@@ -75,10 +76,6 @@ struct OdometryConfig {
   int retry_coarse_iterations = 100;
   double retry_coarse_convergence_m = 0.01;
   double retry_coarse_convergence_rad = 1e-3;
-  /// Coarse end poses closer than this (both) are the same: a quarter of what
-  /// makes two alignments distinct rivals (TrustConfig::distinct_*).
-  double retry_same_translation_m = 0.05;
-  double retry_same_rotation_deg = 0.5;
   /// Frames this long after the previous one (seconds) always run the retries
   /// and are judged with their rivals, trusted first registration or not.
   double always_retry_after_s = 1.5;
