@@ -1,17 +1,20 @@
 // Detection hot paths without a network (issue 23's 200 ms per frame for 3 LiDARs on 2 threads leaves these a few
 // ms): a lyft-sized frame's 200 000 points into the stage-1 BEV grid (96 m x 96 m, 0.4 m pillars), 30 cars'
 // anchor targets on its head grid (stride 2, two yaws: 28 800 anchors), result fusion of 3 LiDARs x 100 boxes, and
-// online calibration of a simulated lyft street frame (both side LiDARs registered to the top one, alpha 0.04).
+// online calibration of a simulated lyft street frame (both side LiDARs registered to the top one, alpha 0.04), and
+// the whole frame read with it (`detect run --refine-extrinsics`) on 1 or 2 threads.
 #include <filesystem>
 #include <numbers>
 #include <random>
 #include <unistd.h>
 
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include "mlidar/core/extrinsic_perturbation.hpp"
 #include "mlidar/detect/anchor_targets.hpp"
 #include "mlidar/detect/bev_grid.hpp"
+#include "mlidar/detect/detection_frames.hpp"
 #include "mlidar/detect/online_extrinsics.hpp"
 #include "mlidar/detect/result_fusion.hpp"
 #include "mlidar/eval/calibration_metrics.hpp"
@@ -98,5 +101,22 @@ void BM_OnlineCalibrationLyftFrame(benchmark::State& state) {
   state.counters["rot_err_deg"] = error_deg / registrations;
 }
 BENCHMARK(BM_OnlineCalibrationLyftFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+/// A lyft test frame read with online calibration (its two side LiDARs registered in parallel), alpha 0.04;
+/// arg: TBB threads (1: the registrations one after the other).
+void BM_ReadFrameWithOnlineCalibration(benchmark::State& state) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / ("mlidar_bench_read_oc_" + std::to_string(::getpid()));
+  sim::DetectionSpec spec;
+  spec.rig = sim::load_rig("lyft");
+  spec.frames = 1;
+  spec.split = sim::DetectionSplit::kTest;
+  sim::write_detection_dataset(spec, folder);
+  const detect::DetectionDataset dataset = detect::DetectionDataset::open(folder, false);
+  const calib::PairRefineConfig online = detect::online_refine_config();
+  const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(dataset.read(0, 0.04, 4, &online));
+  std::filesystem::remove_all(folder);
+}
+BENCHMARK(BM_ReadFrameWithOnlineCalibration)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

@@ -103,6 +103,12 @@ TEST(DetectionFrames, OnlineCalibrationUndoesTheInjectedPerturbationAndShrinksTh
     const DetectionFrame given = dataset.read(k, 0.1, 5);  // the largest alpha of Fig 6.5
     const DetectionFrame refined = dataset.read(k, 0.1, 5, &online);
     ASSERT_EQ(refined.placements.size(), dataset.lidar_names().size());
+    const DetectionFrame again = dataset.read(k, 0.1, 5, &online);  // the registrations run in parallel: the same frame
+    for (std::size_t j = 0; j < refined.placements.size(); ++j) {
+      EXPECT_EQ(again.placements[j].T_base_lidar.matrix(), refined.placements[j].T_base_lidar.matrix());
+      EXPECT_EQ(again.lidars[j].points, refined.lidars[j].points);
+      EXPECT_EQ(again.lidars[j].uncertainty, refined.lidars[j].uncertainty);
+    }
     EXPECT_FALSE(refined.placements[ref].refine_ran);
     EXPECT_EQ(refined.lidars[ref].points, given.lidars[ref].points);
     for (std::size_t j = 0; j < refined.placements.size(); ++j) {

@@ -3,8 +3,11 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
+#include <vector>
 
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
 
 #include "mlidar/core/error.hpp"
 #include "mlidar/core/extrinsic_perturbation.hpp"
@@ -110,28 +113,40 @@ DetectionFrame DetectionDataset::read(std::size_t k, double alpha, std::uint64_t
   const io::SourceFrame source = source_.read(k);
   std::mt19937_64 rng(mix_seed(seed, k));
   const std::optional<Scan>& reference = source.scans[reference_];
-  for (std::size_t j = 0; j < source.scans.size(); ++j) {
-    PerturbationPrior prior;
-    prior.alpha = j == reference_ ? 0.0 : (alpha > 0.0 ? alpha : dataset_alpha_);
-    LidarPlacement placement;
-    placement.T_base_lidar_given =
-        alpha > 0.0 && j != reference_ ? sample_perturbed_extrinsic(T_base_lidar_[j], prior, rng) : T_base_lidar_[j];
-    UncertainPose pose = uncertain_extrinsic(placement.T_base_lidar_given, prior);
-    bool uncertain = prior.alpha > 0.0;
-    const std::optional<Scan>& scan = source.scans[j];
-    if (online_calibration != nullptr && j != reference_ && scan && reference) {
-      const RefinedExtrinsic refined =
-          refine_extrinsic_online(*reference, T_base_lidar_[reference_], *scan, placement.T_base_lidar_given, *online_calibration);
+  const std::size_t count = source.scans.size();
+  // The given extrinsics first, in LiDAR order (one random stream per frame) ...
+  std::vector<PerturbationPrior> priors(count);
+  frame.placements.resize(count);
+  for (std::size_t j = 0; j < count; ++j) {
+    priors[j].alpha = j == reference_ ? 0.0 : (alpha > 0.0 ? alpha : dataset_alpha_);
+    frame.placements[j].T_base_lidar_given =
+        alpha > 0.0 && j != reference_ ? sample_perturbed_extrinsic(T_base_lidar_[j], priors[j], rng) : T_base_lidar_[j];
+  }
+  // ... then online calibration's registrations, independent of each other, in parallel ...
+  std::vector<std::optional<RefinedExtrinsic>> refined(count);
+  if (online_calibration != nullptr && reference) {
+    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t j) {
+      if (j == reference_ || !source.scans[j]) return;
+      refined[j] = refine_extrinsic_online(*reference, T_base_lidar_[reference_], *source.scans[j], frame.placements[j].T_base_lidar_given,
+                                           *online_calibration);
+    });
+  }
+  // ... and each LiDAR's points in the base frame with the extrinsic in use.
+  for (std::size_t j = 0; j < count; ++j) {
+    LidarPlacement& placement = frame.placements[j];
+    UncertainPose pose = uncertain_extrinsic(placement.T_base_lidar_given, priors[j]);
+    bool uncertain = priors[j].alpha > 0.0;
+    if (refined[j]) {
       placement.refine_ran = true;
-      placement.refine_verdict = refined.registration.verdict;
-      if (refined.trusted()) {
-        pose = refined.uncertain_extrinsic;
+      placement.refine_verdict = refined[j]->registration.verdict;
+      if (refined[j]->trusted()) {
+        pose = refined[j]->uncertain_extrinsic;
         uncertain = true;
       }
     }
     placement.T_base_lidar = pose.T;
-    frame.placements.push_back(placement);
-    frame.lidars.push_back(scan ? lidar_points(*scan, pose, prior_point_noise(prior), uncertain) : LidarPoints{});
+    const std::optional<Scan>& scan = source.scans[j];
+    frame.lidars.push_back(scan ? lidar_points(*scan, pose, prior_point_noise(priors[j]), uncertain) : LidarPoints{});
   }
   if (has_labels_) {
     const fs::path path = folder_ / "groundtruth" / "label_2" / (frame.id + ".txt");
