@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 61u);
+  EXPECT_EQ(slam_config_keys().size(), 62u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -131,7 +131,8 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
       "  degeneracy_interval_s: 2\n  epsilon: 0.4\n  time_budget_ms: 3\n  seed: 12\n  min_features: 40\n"
-      "  held_out_share: 0.5\n  held_out_residual_ratio: 2\n  held_out_residual_floor_m: 0.02\n  while_calibrating: true\n"
+      "  held_out_share: 0.5\n  held_out_residual_ratio: 2\n  held_out_residual_floor_m: 0.02\n  max_frame_gap_s: 0.6\n"
+      "  while_calibrating: true\n"
       "mapping:\n"
       "  uncertainty_aware: true\n  trace_threshold_m2: 0.3\n  residual_sigma_m: 0.07\n  range_sigma_m: 0.05\n"
       "  angular_sigma_rad: 0.002\n  voxel_filter_m: 0.25\n  extrinsic_prior_translation_m: 0.03\n"
@@ -195,6 +196,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(sel.held_out_share, 0.5);
   EXPECT_EQ(sel.held_out_residual_ratio, 2.0);
   EXPECT_EQ(sel.held_out_residual_floor_m, 0.02);
+  EXPECT_EQ(sel.max_frame_gap_s, 0.6);
   EXPECT_TRUE(sel.while_calibrating);
   EXPECT_EQ(c.odometry.registration.huber_delta_m, 0.05);
   EXPECT_FALSE(c.odometry.front_end.recover_rows);

@@ -386,6 +386,24 @@ TEST(Odometry, SelectionOfEveryFeatureIsTheRegistrationWithout) {
   }
 }
 
+// The selection chooses by information at the start pose, which the thesis has
+// at 10 Hz: frames farther apart than max_frame_gap_s register every feature
+// (bit for bit the run without selection), closer ones select.
+TEST(Odometry, FramesFartherApartThanTheGapLimitRegisterEveryFeature) {
+  const Drive drive = simulate_drive("rv", 7);
+  std::vector<Frame> every_third;  // 0.3 s apart
+  for (std::size_t k = 0; k < drive.frames.size(); k += 3) every_third.push_back(drive.frames[k]);
+  OdometryConfig wide_gap = selecting(SelectionMethod::kGreedy);
+  wide_gap.registration.selection.max_frame_gap_s = 0.5;
+  Odometry plain({}, drive.lidars), limited(selecting(SelectionMethod::kGreedy), drive.lidars), selecting_all(wide_gap, drive.lidars);
+  for (std::size_t k = 0; k < every_third.size(); ++k) {
+    const FrameResult a = plain.process(every_third[k]), b = limited.process(every_third[k]), c = selecting_all.process(every_third[k]);
+    EXPECT_EQ(a.T_world_base.matrix(), b.T_world_base.matrix()) << "frame " << k;
+    EXPECT_FALSE(b.registration.selection) << "frame " << k;
+    if (k > 0) EXPECT_TRUE(c.registration.selection) << "frame " << k;
+  }
+}
+
 // Sec 5.4.4: the full set's information is weaker in the corridor than in the
 // open campus (the same rig, motion and map size), and each side of the
 // threshold keeps its share of the features.
