@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <numbers>
 #include <random>
+#include <string>
 #include <unistd.h>
 
 #include <benchmark/benchmark.h>
@@ -64,15 +65,21 @@ void BM_ResultFusion3x100(benchmark::State& state) {
 }
 BENCHMARK(BM_ResultFusion3x100)->Unit(benchmark::kMillisecond);
 
-/// Arg 0: online_refine_config(); 1: `calibrate refine`'s defaults without the search. Counters: trusted share and
-/// mean rotation error (deg) against the simulator's extrinsics.
-void BM_OnlineCalibrationLyftFrame(benchmark::State& state) {
-  const std::filesystem::path folder = std::filesystem::temp_directory_path() / ("mlidar_bench_oc_" + std::to_string(::getpid()));
+/// Writes a one-frame simulated lyft test dataset to a new temporary folder named after `tag`; returns the folder.
+std::filesystem::path write_lyft_test_frame(const std::string& tag) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / ("mlidar_bench_" + tag + "_" + std::to_string(::getpid()));
   sim::DetectionSpec spec;
   spec.rig = sim::load_rig("lyft");
   spec.frames = 1;
   spec.split = sim::DetectionSplit::kTest;
   sim::write_detection_dataset(spec, folder);
+  return folder;
+}
+
+/// Arg 0: online_refine_config(); 1: `calibrate refine`'s defaults without the search. Counters: trusted share and
+/// mean rotation error (deg) against the simulator's extrinsics.
+void BM_OnlineCalibrationLyftFrame(benchmark::State& state) {
+  const std::filesystem::path folder = write_lyft_test_frame("oc");
   const io::FrameSource source = io::FrameSource::dataset(folder);
   const io::SourceFrame frame = source.read(0);
   std::filesystem::remove_all(folder);
@@ -105,12 +112,7 @@ BENCHMARK(BM_OnlineCalibrationLyftFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMilli
 /// A lyft test frame read with online calibration (its two side LiDARs registered in parallel), alpha 0.04;
 /// arg: TBB threads (1: the registrations one after the other).
 void BM_ReadFrameWithOnlineCalibration(benchmark::State& state) {
-  const std::filesystem::path folder = std::filesystem::temp_directory_path() / ("mlidar_bench_read_oc_" + std::to_string(::getpid()));
-  sim::DetectionSpec spec;
-  spec.rig = sim::load_rig("lyft");
-  spec.frames = 1;
-  spec.split = sim::DetectionSplit::kTest;
-  sim::write_detection_dataset(spec, folder);
+  const std::filesystem::path folder = write_lyft_test_frame("read_oc");
   const detect::DetectionDataset dataset = detect::DetectionDataset::open(folder, false);
   const calib::PairRefineConfig online = detect::online_refine_config();
   const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));

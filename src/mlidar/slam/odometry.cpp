@@ -290,7 +290,8 @@ void Odometry::adapt_threshold(const SE3& prediction, const SE3& estimate) {
 RegistrationConfig Odometry::frame_registration(const SE3& prediction, double threshold, double centroid_stamp, FrameResult& frame) {
   RegistrationConfig config = config_.registration;
   SelectionConfig& selection = config.selection;
-  if (selection_paused_ || centroid_stamp - centroid_poses_.back().stamp > selection.max_frame_gap_s) selection.method = SelectionMethod::kNone;
+  if (selection_paused_ || centroid_stamp - centroid_poses_.back().stamp > selection.max_frame_gap_s)
+    selection.method = SelectionMethod::kNone;
   if (selection.method == SelectionMethod::kNone || !selection.adaptive) return config;
   if (centroid_stamp - degeneracy_stamp_ >= selection.degeneracy_interval_s) {
     frame.full_set_degeneracy = full_set_degeneracy(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction,

@@ -67,10 +67,11 @@ struct OdometryConfig {
   /// every n-th feature and stops at a looser convergence (it only seeds the
   /// fine pass); the fine pass on every feature then runs from each distinct
   /// coarse end pose (closer than a quarter of trust.distinct_* in both
-  /// translation and rotation counts as the same: 0.05 m and 0.5 deg), except those that converged to a fit no registration may
-  /// have (mean |r| above trust.max_mean_residual_m; the best one always runs).
-  /// Real BALM keyframes, 10 retried frames: 34 full registrations each
-  /// before, 23.8 s of a 26.7 s run; after, 1-2 fine passes per frame, the
+  /// translation and rotation counts as the same: 0.05 m and 0.5 deg), except
+  /// those that converged to a fit no registration may have (mean |r| above
+  /// trust.max_mean_residual_m; the tightest one always runs). Real BALM
+  /// keyframes, 10 retried frames: 34 full registrations each before, 23.8 s
+  /// of registration in a 26.7 s run; after, 1-2 fine passes per frame, the
   /// same pair errors (docs/benchmarks.md "Cheaper retries"). 1: every feature.
   std::size_t retry_coarse_stride = 8;
   int retry_coarse_iterations = 100;
