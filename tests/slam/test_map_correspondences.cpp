@@ -43,6 +43,30 @@ TEST(MapMatcher, PlaneOfGridNeighboursIsTheGridPlane) {
   EXPECT_FALSE(match_plane(map, Vec3(0.0, 0.0, 2.0), 1.0F, config).has_value());
 }
 
+TEST(MapMatcher, APlaneTakesItsExtraNeighboursOnlyWithinTheExtraRadius) {
+  // Five points on z = 0 nearest the query (0, 0, 0.05) (0.05 and 0.112 m away), three more at z = 0.1 on a
+  // 0.3 m circle at 120 deg (0.304 m away). By symmetry the eight points' normal is z and their mean height
+  // 3 x 0.1 / 8 = 0.0375 m, so the query is 0.05 m off the five's plane and 0.0125 m off the eight's.
+  VoxelMap map(1.0, 50);
+  const float s = 0.15F * std::sqrt(3.0F);
+  const std::vector<Eigen::Vector3f> points{{0.0F, 0.0F, 0.0F},  {0.1F, 0.0F, 0.0F}, {-0.1F, 0.0F, 0.0F}, {0.0F, 0.1F, 0.0F},
+                                            {0.0F, -0.1F, 0.0F}, {0.3F, 0.0F, 0.1F}, {-0.15F, s, 0.1F},   {-0.15F, -s, 0.1F}};
+  map.add(points);
+  const Vec3 q(0.0, 0.0, 0.05);
+  const auto residual = [&](int neighbors_max, double extra_radius_m) {
+    RegistrationConfig config;
+    config.plane_neighbors_max = neighbors_max;
+    config.plane_extra_radius_m = extra_radius_m;
+    const auto plane = match_plane(map, q, 1.0F, config);
+    EXPECT_TRUE(plane.has_value());
+    EXPECT_NEAR(std::abs(plane->normal.z()), 1.0, 1e-6);
+    return std::abs(plane->normal.dot(q) + plane->offset);
+  };
+  EXPECT_NEAR(residual(5, 0.5), 0.05, 1e-6);    // the default: five neighbours
+  EXPECT_NEAR(residual(8, 0.5), 0.0125, 1e-6);  // all eight within 0.5 m
+  EXPECT_NEAR(residual(8, 0.3), 0.05, 1e-6);    // the three extra are 0.304 m away: left out
+}
+
 TEST(MapMatcher, LineOfColinearNeighboursIsTheLine) {
   const VoxelMap map = line_map();
   const RegistrationConfig config;

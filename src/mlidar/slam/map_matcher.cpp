@@ -1,5 +1,6 @@
 #include "mlidar/slam/map_matcher.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -35,7 +36,11 @@ bool fit(const Neighbours& points, int count, Neighbourhood& out) {
 std::optional<PlaneCoefficients> match_plane(const VoxelMap& plane_map, const Vec3& q_world, float search_radius_sq,
                                              const RegistrationConfig& config) {
   Neighbours near;
-  const int count = plane_map.nearest(q_world.cast<float>(), config.neighbors, search_radius_sq, near);
+  const Eigen::Vector3f q = q_world.cast<float>();
+  int count = plane_map.nearest(q, std::max(config.neighbors, config.plane_neighbors_max), search_radius_sq, near);
+  // Nearest first: past `neighbors`, keep only the neighbours within the extra radius.
+  const auto extra_sq = static_cast<float>(config.plane_extra_radius_m * config.plane_extra_radius_m);
+  while (count > config.neighbors && (near[static_cast<std::size_t>(count - 1)] - q).squaredNorm() > extra_sq) --count;
   Neighbourhood hood;
   if (count < 3 || !fit(near, count, hood)) return std::nullopt;
   // Colinear neighbours (one scan line) leave the normal's direction free about the line.
