@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 64u);
+  EXPECT_EQ(slam_config_keys().size(), 65u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -127,7 +127,8 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  relative_to_others: false\n"
       "odometry:\n"
       "  plane_voxel_m: 0.7\n  edge_voxel_m: 0.3\n  local_map_radius_m: 80\n  max_iterations: 12\n  refine_deskew: true\n"
-      "  deskew_in_registration: false\n  plane_neighbors_max: 8\n  plane_extra_radius_m: 0.3\n  huber_delta_m: 0.05\n"
+      "  deskew_in_registration: false\n  plane_neighbors_max: 8\n  voxel_plane_neighbors_max: 6\n  plane_extra_radius_m: 0.3\n"
+      "  huber_delta_m: 0.05\n"
       "  recover_rows: false\n"
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
@@ -200,6 +201,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(sel.max_frame_gap_s, 0.6);
   EXPECT_TRUE(sel.while_calibrating);
   EXPECT_EQ(c.odometry.registration.plane_neighbors_max, 8);
+  EXPECT_EQ(c.odometry.voxel_plane_neighbors_max, 6);
   EXPECT_EQ(c.odometry.registration.plane_extra_radius_m, 0.3);
   EXPECT_EQ(c.odometry.registration.huber_delta_m, 0.05);
   EXPECT_FALSE(c.odometry.front_end.recover_rows);

@@ -289,6 +289,7 @@ void Odometry::adapt_threshold(const SE3& prediction, const SE3& estimate) {
 
 RegistrationConfig Odometry::frame_registration(const SE3& prediction, double threshold, double centroid_stamp, FrameResult& frame) {
   RegistrationConfig config = config_.registration;
+  if (voxel_sample_share() > 0.5) config.plane_neighbors_max = config_.voxel_plane_neighbors_max;
   SelectionConfig& selection = config.selection;
   if (selection_paused_ || centroid_stamp - centroid_poses_.back().stamp > selection.max_frame_gap_s)
     selection.method = SelectionMethod::kNone;
@@ -304,13 +305,14 @@ RegistrationConfig Odometry::frame_registration(const SE3& prediction, double th
   return config;
 }
 
-double Odometry::residual_scale() const {
+double Odometry::voxel_sample_share() const {
   std::size_t voxel_samples = 0;
   for (const LidarFeatures& f : features_) voxel_samples += f.voxel_samples;
   const std::size_t all = frame_features_.edges.size() + frame_features_.planes.size();
-  const double share = all > 0 ? static_cast<double>(voxel_samples) / static_cast<double>(all) : 0.0;
-  return 1.0 + (config_.trust.voxel_residual_ratio - 1.0) * share;
+  return all > 0 ? static_cast<double>(voxel_samples) / static_cast<double>(all) : 0.0;
 }
+
+double Odometry::residual_scale() const { return 1.0 + (config_.trust.voxel_residual_ratio - 1.0) * voxel_sample_share(); }
 
 TrustRule Odometry::trust_rule() const { return {config_.trust, residual_scale() * recent_residuals_.median_m()}; }
 

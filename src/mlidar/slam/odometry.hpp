@@ -47,6 +47,11 @@ struct OdometryConfig {
   double edge_voxel_m = 1.0;
   int plane_points_per_voxel = 20;
   int edge_points_per_voxel = 10;
+  /// RegistrationConfig::plane_neighbors_max for a frame whose features are mostly voxel samples (clouds with no
+  /// model and no scan rows: ring-less keyframes, solid-state scanners), whose map is evenly dense; range-image
+  /// (LOAM) features keep registration.plane_neighbors_max. Measured 2026-12-07 (docs/benchmarks.md "More
+  /// neighbours for the plane fit"): 8 on real Ouster keyframes, 5 on the simulated 16-beam rigs.
+  int voxel_plane_neighbors_max = 8;
   double local_map_radius_m = 100.0;
   double initial_threshold_m = 2.0;  ///< correspondence distance before any motion is seen
   double min_threshold_m = 0.3;
@@ -188,8 +193,11 @@ class Odometry {
   void apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered);
   /// 1 + (TrustConfig::voxel_residual_ratio - 1) x the share of voxel samples among this frame's features.
   double residual_scale() const;
+  /// The current frame's share of voxel samples among its features, in [0, 1].
+  double voxel_sample_share() const;
   TrustRule trust_rule() const;
-  /// The registration settings of this frame: with adaptive feature selection,
+  /// The registration settings of this frame: the plane fit by its kind of features (voxel_plane_neighbors_max when
+  /// mostly voxel samples); with adaptive feature selection,
   /// lambda is evaluated again every degeneracy_interval_s and sets M (sec 5.4.4).
   RegistrationConfig frame_registration(const SE3& prediction, double threshold, double centroid_stamp, FrameResult& frame);
   /// Registrations from the retry starts (prediction and previous pose, turned).

@@ -45,8 +45,9 @@ struct RegistrationConfig {
   /// when the extra ones lie within plane_extra_radius_m of the query: a dense map's extra neighbours average
   /// the noise of the fit, a sparse map's would bend it over a curved or stepped surface. Measured 2026-12-07
   /// (docs/benchmarks.md "More neighbours for the plane fit"): 8 within 0.5 m takes real Ouster keyframes' pair
-  /// rotation median from 0.056 to 0.041 deg, but moves simulated rigs' ATE by -6 to +20 % and `calibrate auto`
-  /// on short handheld runs either way, so the default keeps the fit at `neighbors`.
+  /// rotation median from 0.056 to 0.041 deg, but moves simulated 16-beam rigs' ATE by -6 to +20 % and
+  /// `calibrate auto` on short handheld runs either way; so 5 here, and the odometry sets
+  /// OdometryConfig::voxel_plane_neighbors_max (8) for frames of voxel samples.
   int plane_neighbors_max = 5;
   double plane_extra_radius_m = 0.5;
   double neighborhood_radius_m = 1.0;  ///< map neighbours are searched at least this far (the map's density, not the pose error)
