@@ -175,7 +175,7 @@ std::vector<Field> odometry_fields(SlamConfig& c) {
       {"odometry",
        "plane_neighbors_max",
        {5, 8},
-       "a plane is fitted to its 5 nearest map points and up to this many when the extra ones lie within plane_extra_radius_m (range-image features)",
+       "range-image features: a plane fits its 5 nearest map points, up to this many when the rest lie within plane_extra_radius_m",
        &odo.registration.plane_neighbors_max},
       {"odometry",
        "voxel_plane_neighbors_max",
