@@ -386,6 +386,31 @@ TEST(Odometry, SelectionOfEveryFeatureIsTheRegistrationWithout) {
   }
 }
 
+// A plane takes up to plane_neighbors_max map neighbours in frames of range-image
+// features and up to voxel_plane_neighbors_max in frames of voxel samples (no
+// model and no rows): each setting changes its own kind of frame and not the other.
+TEST(Odometry, ThePlaneFitFollowsTheKindOfFeatures) {
+  const Drive drive = simulate_drive("rv", 4);
+  std::vector<LidarSetup> without_model = drive.lidars;
+  for (LidarSetup& lidar : without_model) lidar.model.vertical_angles_deg.clear();
+  const auto poses = [&](int plane_max, int voxel_plane_max, const std::vector<LidarSetup>& lidars) {
+    OdometryConfig config;
+    config.registration.plane_neighbors_max = plane_max;
+    config.voxel_plane_neighbors_max = voxel_plane_max;
+    config.front_end.recover_rows = false;  // no rows from the ring channel either: voxel samples
+    Odometry odometry(config, lidars);
+    std::vector<Mat4> out;
+    for (const Frame& frame : drive.frames) out.push_back(odometry.process(frame).T_world_base.matrix());
+    return out;
+  };
+  const auto range_image = poses(5, 5, drive.lidars);
+  EXPECT_EQ(range_image, poses(5, 8, drive.lidars));  // bit for bit
+  EXPECT_NE(range_image, poses(8, 5, drive.lidars));
+  const auto voxel_samples = poses(5, 5, without_model);
+  EXPECT_EQ(voxel_samples, poses(8, 5, without_model));
+  EXPECT_NE(voxel_samples, poses(5, 8, without_model));
+}
+
 // The selection chooses by information at the start pose, which the thesis has
 // at 10 Hz: frames farther apart than max_frame_gap_s register every feature
 // (bit for bit the run without selection), closer ones select.
