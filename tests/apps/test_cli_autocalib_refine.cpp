@@ -124,10 +124,15 @@ TEST(CliAutoCalibRefine, LyftBumperLidarsFromNoGuessOnTheStreet) {
     EXPECT_TRUE(refine["fused_by_information"].get<bool>()) << refine.dump(1);
     EXPECT_LE(refine["fusion"]["translation_sd_m"].get<double>(), 0.015);
     searched = searched || refine["start"] == "search";
-    // The hand-eye start alone was far off: that is what made the search necessary.
+    // The hand-eye gave no start (its LiDAR's own odometry is degenerate on this street), or one far off whose
+    // refinement failed: that is what made the search necessary.
     if (refine["start"] == "search") {
-      EXPECT_GT(translation_error_m(T_true, truth.find("top")->T_base_lidar * pose_from_json((*it)["handeye"]["T_base_lidar"])), 0.5);
-      EXPECT_NE((*it)["refine_unsearched"]["verdict"], "ok");
+      if (it->contains("refine_unsearched")) {
+        EXPECT_GT(translation_error_m(T_true, truth.find("top")->T_base_lidar * pose_from_json((*it)["handeye"]["T_base_lidar"])), 0.5);
+        EXPECT_NE((*it)["refine_unsearched"]["verdict"], "ok");
+      } else {
+        EXPECT_NE((*it)["handeye"]["verdict"], "ok");
+      }
     }
   }
   EXPECT_TRUE(searched);

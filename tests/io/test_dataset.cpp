@@ -19,9 +19,11 @@ Dataset example() {
   top.model.name = "RS-LiDAR-16";
   top.model.vertical_angles_deg = {-15.0, -13.0, 0.1 + 0.2};
   top.model.horizontal_resolution_deg = 0.2;
+  top.model.range_noise_sigma = 0.05;
   top.scans = "scans/top";
   top.initial_extrinsic = SE3(so3_exp(Vec3(0.1, 0.2, -0.3)), Vec3(0.8, 1.0 / 3.0, -1.36));
   DatasetLidar front = top;
+  front.model.range_noise_sigma = 0.0;  // not known: not written
   front.name = "front";
   front.scans = "scans/front";
   front.initial_extrinsic.reset();
@@ -42,6 +44,8 @@ TEST(Dataset, YamlRoundTripIsExact) {
   EXPECT_EQ(read.reference_lidar, "top");
   ASSERT_EQ(read.lidars.size(), 2u);
   EXPECT_EQ(read.lidars[0].model.vertical_angles_deg, original.lidars[0].model.vertical_angles_deg);
+  EXPECT_EQ(read.lidars[0].model.range_noise_sigma, 0.05);
+  EXPECT_EQ(read.lidars[1].model.range_noise_sigma, 0.0);
   EXPECT_EQ(read.lidars[0].scans, "scans/top");
   ASSERT_TRUE(read.lidars[0].initial_extrinsic);
   EXPECT_EQ(read.lidars[0].initial_extrinsic->translation(), original.lidars[0].initial_extrinsic->translation());
@@ -91,6 +95,8 @@ TEST(Dataset, ErrorsNameTheKey) {
   expect_key(head + "lidars: [{name: a, model: m, scans: s, vertical_angles_deg: [-1, 1, 1]}]\n", "lidars[0].vertical_angles_deg[2]");
   expect_key(head + "lidars: [{name: a, model: m, scans: s, min_range: 5, max_range: 5}]\n", "lidars[0].max_range");
   expect_key(head + "lidars: [{name: a, model: m, scans: s, time_unit: weeks}]\n", "lidars[0].time_unit");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, range_noise_sigma: -0.03}]\n", "lidars[0].range_noise_sigma");
+  expect_key(head + "lidars: [{name: a, model: m, scans: s, range_noise_sigma: .nan}]\n", "lidars[0].range_noise_sigma");
   expect_key(head, "lidars");
   expect_key(head + "lidars: [{name: a, model: m, scans: s}]\ncolour: red\n", "colour");
   expect_key(head + "lidars: [{name: a, model: m}]\n", "lidars[0].scans");

@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 65u);
+  EXPECT_EQ(slam_config_keys().size(), 66u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -128,7 +128,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "odometry:\n"
       "  plane_voxel_m: 0.7\n  edge_voxel_m: 0.3\n  local_map_radius_m: 80\n  max_iterations: 12\n  refine_deskew: true\n"
       "  deskew_in_registration: false\n  plane_neighbors_max: 8\n  voxel_plane_neighbors_max: 6\n  plane_extra_radius_m: 0.3\n"
-      "  huber_delta_m: 0.05\n"
+      "  plane_min_extent_sigmas: 0.8\n  huber_delta_m: 0.05\n"
       "  recover_rows: false\n"
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
@@ -203,6 +203,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(c.odometry.registration.plane_neighbors_max, 8);
   EXPECT_EQ(c.odometry.voxel_plane_neighbors_max, 6);
   EXPECT_EQ(c.odometry.registration.plane_extra_radius_m, 0.3);
+  EXPECT_EQ(c.odometry.plane_min_extent_sigmas, 0.8);
   EXPECT_EQ(c.odometry.registration.huber_delta_m, 0.05);
   EXPECT_FALSE(c.odometry.front_end.recover_rows);
   const slam::UncertaintyConfig& ua = c.odometry.uncertainty;

@@ -3,6 +3,8 @@
 // by a known distance gives that residual; a window problem built from them
 // has the documented frame, LiDAR and world geometry; a feature beyond the gate is dropped.
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -65,6 +67,34 @@ TEST(MapMatcher, APlaneTakesItsExtraNeighboursOnlyWithinTheExtraRadius) {
   EXPECT_NEAR(residual(5, 0.5), 0.05, 1e-6);    // the default: five neighbours
   EXPECT_NEAR(residual(8, 0.5), 0.0125, 1e-6);  // all eight within 0.5 m
   EXPECT_NEAR(residual(8, 0.3), 0.05, 1e-6);    // the three extra are 0.304 m away: left out
+}
+
+TEST(MapMatcher, APatchOfOneScanLineNarrowerThanTheRangeNoiseIsNoPlane) {
+  // A 16-beam LiDAR 1.3 m above the ground: the -15 deg beam every 0.1 deg of azimuth, each range 5 cm long or
+  // short in turn (range noise lies along the beams). The five points nearest the ground point below the middle
+  // beam span 1.2 cm across the beams and 10 cm along them: they lie on the sheet the beams sweep, and pass the
+  // colinearity and tolerance checks with a normal 15 deg off the ground's.
+  const double elevation = -15.0 * std::numbers::pi / 180.0;
+  const double ground_range = 1.3 / std::sin(-elevation);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = -10; i <= 10; ++i) {
+    const double azimuth = 0.1 * i * std::numbers::pi / 180.0;
+    const Vec3 beam(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    points.push_back(((ground_range + (i % 2 == 0 ? -0.05 : 0.05)) * beam).cast<float>());
+  }
+  VoxelMap map(1.0, 50);
+  map.add(points);
+  const Vec3 q = ground_range * Vec3(std::cos(elevation), 0.0, std::sin(elevation));
+  RegistrationConfig config;
+  const auto sheet = match_plane(map, q, 1.0F, config);
+  ASSERT_TRUE(sheet.has_value());
+  EXPECT_GT(std::acos(std::abs(sheet->normal.z())) * 180.0 / std::numbers::pi, 14.0);
+  config.plane_min_extent_m = 0.025;  // half the 5 cm range sigma
+  EXPECT_FALSE(match_plane(map, q, 1.0F, config).has_value());
+  // A patch wider than the noise still is: the 0.1 m grid's five nearest spread 6 cm.
+  const auto grid = match_plane(plane_map(), Vec3(0.23, -0.41, 0.35), 1.0F, config);
+  ASSERT_TRUE(grid.has_value());
+  EXPECT_NEAR(std::abs(grid->normal.z()), 1.0, 1e-9);
 }
 
 TEST(MapMatcher, LineOfColinearNeighboursIsTheLine) {

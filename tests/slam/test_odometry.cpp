@@ -386,6 +386,27 @@ TEST(Odometry, SelectionOfEveryFeatureIsTheRegistrationWithout) {
   }
 }
 
+// A map patch must be wider than the range noise of the LiDARs that built the map
+// (plane_min_extent_sigmas of the noisiest one's sigma, the configured one where the
+// model gives none), and follows the LiDARs when they change.
+TEST(Odometry, ThePlanePatchWidthFollowsTheNoisiestLidar) {
+  LidarModel quiet, noisy, unknown;
+  quiet.range_noise_sigma = 0.01;
+  noisy.range_noise_sigma = 0.05;
+  const LidarSetup a{"a", quiet, SE3::identity()}, b{"b", noisy, SE3::identity()}, c{"c", unknown, SE3::identity()};
+  OdometryConfig config;
+  config.plane_min_extent_sigmas = 0.5;
+  config.uncertainty.range_sigma_m = 0.04;
+  Odometry odometry(config, {a, b});
+  EXPECT_DOUBLE_EQ(odometry.config().registration.plane_min_extent_m, 0.025);
+  odometry.set_lidars({a});
+  EXPECT_DOUBLE_EQ(odometry.config().registration.plane_min_extent_m, 0.005);
+  odometry.set_lidars({a, c});
+  EXPECT_DOUBLE_EQ(odometry.config().registration.plane_min_extent_m, 0.02);
+  config.plane_min_extent_sigmas = 0.0;
+  EXPECT_EQ(Odometry(config, {a, b}).config().registration.plane_min_extent_m, 0.0);
+}
+
 // A plane takes up to plane_neighbors_max map neighbours in frames of range-image
 // features and up to voxel_plane_neighbors_max in frames of voxel samples (no
 // model and no rows): each setting changes its own kind of frame and not the other.
@@ -487,9 +508,12 @@ TEST(Odometry, DefaultDegeneracyThresholdSeparatesTheCorridorDriveFromTheCampus)
 }
 
 // refine_deskew: the frame deskewed again with the velocity its registration
-// measured and registered once more follows the drive at least as well.
+// measured and registered once more follows the drive at least as well. 20
+// frames: over 12 the summed errors (3 cm) differ by a few millimetres
+// either way with the map's plane fit (2026-12-07: 7 % against refined).
 TEST(Odometry, RefinedDeskewFollowsTheDriveAtLeastAsWell) {
-  const Drive drive = simulate_drive("rv", 12);
+  constexpr int kFrames = 20;
+  const Drive drive = simulate_drive("rv", kFrames);
   OdometryConfig refined_config;
   refined_config.refine_deskew = true;
   Odometry plain({}, drive.lidars), refined(refined_config, drive.lidars);
@@ -502,9 +526,9 @@ TEST(Odometry, RefinedDeskewFollowsTheDriveAtLeastAsWell) {
     refined_sum_m += error.translation().norm();
     refined_worst_deg = std::max(refined_worst_deg, rotation_angle_deg(error));
   }
-  std::printf("mean translation error: plain %.4f m, refined %.4f m\n", plain_sum_m / 12.0, refined_sum_m / 12.0);
+  std::printf("mean translation error: plain %.4f m, refined %.4f m\n", plain_sum_m / kFrames, refined_sum_m / kFrames);
   EXPECT_LE(refined_sum_m, 1.05 * plain_sum_m);
-  EXPECT_LT(refined_sum_m / 12.0, 0.05);
+  EXPECT_LT(refined_sum_m / kFrames, 0.05);
   EXPECT_LT(refined_worst_deg, 0.2);
 }
 

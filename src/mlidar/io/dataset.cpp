@@ -58,8 +58,8 @@ class Checker : public YamlFields {
 
   DatasetLidar lidar(const YAML::Node& node, const std::string& key) const {
     only_keys(node, key,
-              {"name", "model", "scans", "vertical_angles_deg", "horizontal_resolution_deg", "min_range", "max_range", "initial_extrinsic",
-               "time_unit"});
+              {"name", "model", "scans", "vertical_angles_deg", "horizontal_resolution_deg", "min_range", "max_range", "range_noise_sigma",
+               "initial_extrinsic", "time_unit"});
     DatasetLidar lidar;
     lidar.name = text(node["name"], key + ".name");
     if (!std::regex_match(lidar.name, std::regex("[A-Za-z0-9_-]+"))) fail(key + ".name", "use letters, digits, '_' or '-'");
@@ -77,6 +77,7 @@ class Checker : public YamlFields {
     positive("max_range", lidar.model.max_range);
     if (!(lidar.model.max_range > lidar.model.min_range))
       fail(key + ".max_range", "must be greater than min_range (" + std::to_string(lidar.model.min_range) + " m)");
+    positive("range_noise_sigma", lidar.model.range_noise_sigma);
     if (node["time_unit"]) {
       const auto unit = parse_time_unit(text(node["time_unit"], key + ".time_unit"));
       if (!unit) fail(key + ".time_unit", "expected s, ms, us, ns or auto");
@@ -180,6 +181,8 @@ std::string format_dataset_yaml(const Dataset& dataset) {
     out << YAML::Key << "horizontal_resolution_deg" << YAML::Value << exact_number(lidar.model.horizontal_resolution_deg);
     out << YAML::Key << "min_range" << YAML::Value << exact_number(lidar.model.min_range);
     out << YAML::Key << "max_range" << YAML::Value << exact_number(lidar.model.max_range);
+    if (lidar.model.range_noise_sigma > 0.0)
+      out << YAML::Key << "range_noise_sigma" << YAML::Value << exact_number(lidar.model.range_noise_sigma);
     if (lidar.time_unit != TimeUnit::kAuto) out << YAML::Key << "time_unit" << YAML::Value << time_unit_name(lidar.time_unit);
     if (lidar.initial_extrinsic) {
       const SE3& T = *lidar.initial_extrinsic;

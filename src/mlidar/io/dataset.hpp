@@ -22,6 +22,8 @@
 //       horizontal_resolution_deg: 0.2
 //       min_range: 0.4
 //       max_range: 150                # > min_range
+//       range_noise_sigma: 0.03       # optional range 1-sigma (m), > 0; the SLAM's plane fit and point
+//                                     # covariances take mapping.range_sigma_m without it
 //       time_unit: ns                 # optional: s, ms, us or ns of the per-point time
 //                                     # field (default from its type, io/point_table.hpp)
 //       initial_extrinsic:            # optional T_base_lidar guess, p_base = R p_lidar + t

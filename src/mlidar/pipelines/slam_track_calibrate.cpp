@@ -52,7 +52,8 @@ TrackTransition LidarTrack::calibrate(Calibrating& state, const TrackFrame& fram
   if (state.window.size() > static_cast<std::size_t>(config_->window.size + 1)) state.window.erase(state.window.begin());
 
   // Eq 4.21: the window's poses are fixed by the map; T_base_lidar_j is the variable.
-  const slam::MapView map{frame.trusted->edge_map(), frame.trusted->plane_map(), config_->odometry.registration};
+  // The trusted odometry's plane fit: its map, fitted as its LiDARs' noise allows (plane_min_extent_m).
+  const slam::MapView map{frame.trusted->edge_map(), frame.trusted->plane_map(), frame.trusted->config().registration};
   slam::CalibrationWindowOptions options;
   options.huber_delta_m = config_->odometry.registration.huber_delta_m;
   options.settle_passes = config_->window.calibration_settle_passes;

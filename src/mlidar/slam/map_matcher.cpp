@@ -45,6 +45,8 @@ std::optional<PlaneCoefficients> match_plane(const VoxelMap& plane_map, const Ve
   if (count < 3 || !fit(near, count, hood)) return std::nullopt;
   // Colinear neighbours (one scan line) leave the normal's direction free about the line.
   if (hood.eigen.eigenvalues()(1) < config.plane_spread * hood.eigen.eigenvalues()(0)) return std::nullopt;
+  // Narrower than the range noise: the noise along the beams, not the surface, sets the normal.
+  if (hood.eigen.eigenvalues()(1) < config.plane_min_extent_m * config.plane_min_extent_m) return std::nullopt;
   const PlaneCoefficients plane{hood.eigen.eigenvectors().col(0), -hood.eigen.eigenvectors().col(0).dot(hood.mean)};
   for (int i = 0; i < count; ++i)
     if (std::abs(plane.normal.dot(near[static_cast<std::size_t>(i)].cast<double>()) + plane.offset) > config.plane_tolerance_m)

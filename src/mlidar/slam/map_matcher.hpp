@@ -2,7 +2,8 @@
 // Correspondence search against a voxel-hashed local map (thesis eq 4.7/4.8):
 // the k nearest map points of a world point, fitted by PCA
 //   plane: every neighbour within plane_tolerance_m of the plane and the
-//          neighbours not colinear (middle eigenvalue >= plane_spread x smallest);
+//          neighbours not colinear (middle eigenvalue >= plane_spread x smallest)
+//          and spread across at least plane_min_extent_m (sqrt of the middle eigenvalue);
 //   line:  largest eigenvalue >= edge_linearity x middle one and every
 //          neighbour within edge_tolerance_m of the line.
 // Shared by scan-to-map registration and the back end's window correspondences.

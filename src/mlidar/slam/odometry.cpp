@@ -18,6 +18,18 @@
 namespace mlidar::slam {
 namespace {
 
+/// The range 1-sigma for a LiDAR's points: its model's, else the configured one.
+double range_sigma(const LidarSetup& lidar, const UncertaintyConfig& ua) {
+  return lidar.model.range_noise_sigma > 0.0 ? lidar.model.range_noise_sigma : ua.range_sigma_m;
+}
+
+/// RegistrationConfig::plane_min_extent_m for a map built by `lidars`: the noisiest one's range sigma, scaled.
+double plane_min_extent(const OdometryConfig& config, const std::vector<LidarSetup>& lidars) {
+  double sigma = 0.0;
+  for (const LidarSetup& lidar : lidars) sigma = std::max(sigma, range_sigma(lidar, config.uncertainty));
+  return config.plane_min_extent_sigmas * sigma;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -161,11 +173,13 @@ Odometry::Odometry(OdometryConfig config, std::vector<LidarSetup> lidars)
       recent_residuals_(config_.trust.residual_history),
       registration_(config_.registration) {
   if (lidars_.empty()) throw std::invalid_argument("Odometry: no LiDARs");
+  config_.registration.plane_min_extent_m = registration_.plane_min_extent_m = plane_min_extent(config_, lidars_);
 }
 
 void Odometry::set_lidars(std::vector<LidarSetup> lidars) {
   if (lidars.empty()) throw std::invalid_argument("Odometry::set_lidars: no LiDARs");
   lidars_ = std::move(lidars);
+  config_.registration.plane_min_extent_m = plane_min_extent(config_, lidars_);
   workspaces_ = std::vector<FrontEndWorkspace>(lidars_.size());
   features_ = std::vector<LidarFeatures>(lidars_.size());
 }
@@ -439,11 +453,6 @@ std::size_t drop_uncertain_features(double trace_threshold_m2, LidarFeatures& f,
   keep_where(keep_planes, f.plane_times);
   keep_where(keep_planes, plane_covariances);
   return before - f.edges.size() - f.planes.size();
-}
-
-/// The range 1-sigma for a LiDAR's points: its model's, else the configured one.
-double range_sigma(const LidarSetup& lidar, const UncertaintyConfig& ua) {
-  return lidar.model.range_noise_sigma > 0.0 ? lidar.model.range_noise_sigma : ua.range_sigma_m;
 }
 
 }  // namespace

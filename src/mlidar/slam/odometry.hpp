@@ -52,6 +52,12 @@ struct OdometryConfig {
   /// (LOAM) features keep registration.plane_neighbors_max. Measured 2026-12-07 (docs/benchmarks.md "More
   /// neighbours for the plane fit"): 8 on real Ouster keyframes, 5 on the simulated 16-beam rigs.
   int voxel_plane_neighbors_max = 8;
+  /// RegistrationConfig::plane_min_extent_m in units of the range 1-sigma of the noisiest LiDAR (its model's, else
+  /// uncertainty.range_sigma_m); the odometry sets it from its LiDARs (construction, set_lidars). Measured
+  /// 2026-12-07 (docs/benchmarks.md "Plane patches narrower than the range noise"): 0.5 takes issue 9's handheld
+  /// protocol (5 cm noise) from ATE 8.1 to 7.1 mm and its online calibration from 0.105 to 0.069 deg; a whole
+  /// sigma leaves too few planes in a room.
+  double plane_min_extent_sigmas = 0.5;
   double local_map_radius_m = 100.0;
   double initial_threshold_m = 2.0;  ///< correspondence distance before any motion is seen
   double min_threshold_m = 0.3;

@@ -54,6 +54,11 @@ struct RegistrationConfig {
   double plane_tolerance_m = 0.2;
   double huber_delta_m = 0.1;  ///< Huber scale on |r| (eq 4.9's rho)
   double plane_spread = 3.0;   ///< a plane needs middle eigenvalue >= this x smallest
+  /// A plane needs its neighbours spread at least this far across (m, the square root of the middle eigenvalue of
+  /// their covariance). Range noise lies along the beams: a patch narrower than it (a few points of one scan
+  /// line) gets its normal from the noise, not the surface. The odometry sets it from its LiDARs' range noise
+  /// (OdometryConfig::plane_min_extent_sigmas); 0 leaves it unchecked.
+  double plane_min_extent_m = 0.0;
   double edge_linearity = 10.0;
   double edge_tolerance_m = 0.1;  ///< every edge neighbour within this of the fitted line
   /// Measured (rv rig, 40 frames each): campus 0.19-0.35, corridor 0.03-0.05.
