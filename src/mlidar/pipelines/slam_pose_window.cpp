@@ -34,7 +34,7 @@ std::optional<slam::OdometryWindowUpdate> SlamPoseWindow::add(std::size_t frame,
                                                               const slam::Odometry& odometry) {
   if (frame < 1 || result.flagged()) return std::nullopt;
   if (!window_) {
-    config_.registration.plane_min_extent_m = odometry.config().registration.plane_min_extent_m;  // from its LiDARs' noise
+    config_.registration = odometry.config().registration;  // its map fitted as the odometry fits it (its LiDARs' noise)
     window_.emplace(config_, odometry.edge_map(), odometry.plane_map());  // frames 0 and 1, as rebuilt at frame 1
     return std::nullopt;
   }

@@ -173,7 +173,7 @@ Odometry::Odometry(OdometryConfig config, std::vector<LidarSetup> lidars)
       recent_residuals_(config_.trust.residual_history),
       registration_(config_.registration) {
   if (lidars_.empty()) throw std::invalid_argument("Odometry: no LiDARs");
-  config_.registration.plane_min_extent_m = registration_.plane_min_extent_m = plane_min_extent(config_, lidars_);
+  config_.registration.plane_min_extent_m = plane_min_extent(config_, lidars_);  // registration_ is set per frame
 }
 
 void Odometry::set_lidars(std::vector<LidarSetup> lidars) {
