@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 66u);
+  EXPECT_EQ(slam_config_keys().size(), 68u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -129,7 +129,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  plane_voxel_m: 0.7\n  edge_voxel_m: 0.3\n  local_map_radius_m: 80\n  max_iterations: 12\n  refine_deskew: true\n"
       "  deskew_in_registration: false\n  plane_neighbors_max: 8\n  voxel_plane_neighbors_max: 6\n  plane_extra_radius_m: 0.3\n"
       "  plane_min_extent_sigmas: 0.8\n  huber_delta_m: 0.05\n"
-      "  recover_rows: false\n"
+      "  recover_rows: false\n  recover_rows_max_skip: 4\n  voxel_coarse_stride: 3\n"
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
       "  degeneracy_interval_s: 2\n  epsilon: 0.4\n  time_budget_ms: 3\n  seed: 12\n  min_features: 40\n"
@@ -206,6 +206,8 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(c.odometry.plane_min_extent_sigmas, 0.8);
   EXPECT_EQ(c.odometry.registration.huber_delta_m, 0.05);
   EXPECT_FALSE(c.odometry.front_end.recover_rows);
+  EXPECT_EQ(c.odometry.front_end.recover_rows_max_skip, 4);
+  EXPECT_EQ(c.odometry.voxel_coarse_stride, 3);
   const slam::UncertaintyConfig& ua = c.odometry.uncertainty;
   EXPECT_TRUE(ua.enabled);
   EXPECT_EQ(ua.trace_threshold_m2, 0.3);

@@ -11,6 +11,7 @@
 
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/point_table.hpp"
+#include "mlidar/slam/frontend.hpp"
 #include "mlidar/slam/row_recovery.hpp"
 #include "synthetic_scans.hpp"
 #include "test_support.hpp"
@@ -114,6 +115,57 @@ TEST(RowRecovery, FindsNoRowsWhereThereAreNoBeams) {
     const auto rows = recover_rows(points);
     EXPECT_FALSE(rows.has_value()) << count << " points: " << (rows ? rows->model.rings() : 0) << " rows";
   }
+}
+
+/// Points over a 70 deg cone at 2-30 m, as a solid-state scanner's rosette: no beams.
+Scan rosette_scan(std::size_t count, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> range(2.0, 30.0);
+  Scan scan;
+  while (scan.points.size() < count) {
+    const double y = unit(rng), z = unit(rng);
+    if (y * y + z * z > 1.0) continue;
+    scan.points.push_back((range(rng) * Eigen::Vector3d(1.0, 0.7 * y, 0.7 * z).normalized()).cast<float>());
+  }
+  return scan;
+}
+
+/// The row source the front end gives each scan in turn, one LiDAR without a model, one workspace.
+std::vector<RowSource> row_sources(const std::vector<const Scan*>& scans, int max_skip) {
+  FrontEndConfig config;
+  config.recover_rows_max_skip = max_skip;
+  const LidarSetup lidar{"solid", LidarModel{}, SE3::identity()};
+  FrontEndWorkspace workspace;
+  std::vector<RowSource> sources;
+  for (const Scan* scan : scans) {
+    LidarFeatures features;
+    StageSeconds seconds{};
+    run_front_end(*scan, scan->stamp, lidar, BodyVelocity{}, config, workspace, features, seconds);
+    sources.push_back(features.row_source);
+  }
+  return sources;
+}
+
+// After a scan without rows the next 1, then 2, 4, ... scans (up to the cap)
+// take the voxel samples unsearched, even one that would show rows; a scan
+// searched and recovered resets the back-off.
+TEST(RowRecovery, TheFrontEndBacksOffFromScansThatShowNoRows) {
+  const LidarModel model = test::uniform_model(16, -15.0, 15.0, 0.4);
+  Scan beams = room_scan(model).scan;
+  beams.ring.clear();
+  const Scan none = rosette_scan(20000, 5);
+  constexpr RowSource kFallback = RowSource::kVoxelFallback, kRows = RowSource::kRecovered;
+  // none: searched, refused, skip 1; beams: skipped; none: refused, skip 2; beams x2 skipped; beams found (reset);
+  // none: refused, skip 1 again.
+  const std::vector<const Scan*> sequence = {&none, &beams, &none, &beams, &beams, &beams, &beams, &none, &beams, &beams};
+  EXPECT_EQ(row_sources(sequence, 16),
+            (std::vector<RowSource>{kFallback, kFallback, kFallback, kFallback, kFallback, kRows, kRows, kFallback, kFallback, kRows}));
+  // The cap: at most one scan skipped after each refusal.
+  EXPECT_EQ(row_sources({&none, &beams, &none, &beams, &none, &beams, &beams}, 1),
+            (std::vector<RowSource>{kFallback, kFallback, kFallback, kFallback, kFallback, kFallback, kRows}));
+  // 0: every scan searched.
+  EXPECT_EQ(row_sources({&none, &beams, &none, &beams}, 0), (std::vector<RowSource>{kFallback, kRows, kFallback, kRows}));
 }
 
 // BALM's Ouster keyframes (already deskewed): 64 beams over a 90 deg field of

@@ -58,9 +58,18 @@ ScanRows scan_rows(const Scan& scan, const LidarSetup& lidar, const FrontEndConf
   ws.recovered.reset();
   if (!lidar.model.vertical_angles_deg.empty()) return {&lidar.model, scan.ring, RowSource::kModel};
   if (!config.recover_rows) return {&lidar.model, scan.ring, RowSource::kVoxelFallback};
-  StageTimer timer(seconds, Stage::kRangeImage);
-  ws.recovered = scan.has_ring() ? rows_from_ring_channel(scan.points, scan.ring, config.row_recovery)
-                                 : recover_rows(scan.points, config.row_recovery);
+  if (scan.has_ring()) {
+    StageTimer timer(seconds, Stage::kRangeImage);
+    ws.recovered = rows_from_ring_channel(scan.points, scan.ring, config.row_recovery);
+  } else if (ws.recovery_skips_left > 0) {
+    --ws.recovery_skips_left;
+  } else {
+    StageTimer timer(seconds, Stage::kRangeImage);
+    ws.recovered = recover_rows(scan.points, config.row_recovery);
+    const int skip = std::min(ws.recovery_next_skip, config.recover_rows_max_skip);
+    ws.recovery_skips_left = ws.recovered ? 0 : skip;
+    ws.recovery_next_skip = ws.recovered ? 1 : std::min(2 * skip, config.recover_rows_max_skip);
+  }
   if (!ws.recovered) return {&lidar.model, scan.ring, RowSource::kVoxelFallback};
   ws.recovered->model.max_range = lidar.model.max_range;
   return {&ws.recovered->model, ws.recovered->ring, scan.has_ring() ? RowSource::kRingChannel : RowSource::kRecovered};

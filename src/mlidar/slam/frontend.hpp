@@ -39,6 +39,12 @@ struct FrontEndConfig {
   double fallback_voxel_m = 0.5;  ///< subsample size for LiDARs without a model
   /// For LiDARs without a model: recover each scan's rows (on) or always use the voxel fallback.
   bool recover_rows = true;
+  /// After a ring-less scan whose rows could not be recovered, the same LiDAR's next 1, then 2, 4, ... scans
+  /// (doubling after each refusal, at most this many) take the voxel fallback without searching; a recovered scan
+  /// resets it; 0: search every scan. A scanner whose clouds show no rows (solid-state, sweeps merged while moving)
+  /// keeps showing none, and each refused search costs 10-20 ms of a 75k-point cloud: on real BALM keyframes 87 of
+  /// 100 are refused, a third of the run (docs/benchmarks.md "A coarse pass before the full registration").
+  int recover_rows_max_skip = 16;
   RowRecoveryConfig row_recovery;
 };
 
@@ -70,7 +76,8 @@ struct LidarFeatures {
   std::size_t voxel_samples = 0;
 };
 
-/// Buffers reused across frames (one per LiDAR, so LiDARs can run in parallel).
+/// Buffers reused across frames (one per LiDAR, so LiDARs can run in parallel), and the row recovery's back-off
+/// between one LiDAR's consecutive scans (FrontEndConfig::recover_rows_max_skip; a fresh workspace searches).
 struct FrontEndWorkspace {
   RangeImage image;
   Segmentation segmentation;
@@ -78,6 +85,8 @@ struct FrontEndWorkspace {
   FeatureIndices indices;
   std::vector<double> sorted_angles_deg;
   std::optional<RecoveredRows> recovered;
+  int recovery_skips_left = 0;  ///< scans still to take the fallback without searching
+  int recovery_next_skip = 1;   ///< scans to skip after the next refusal
 };
 
 /// Runs the front end; `velocity` deskews each point to the base at

@@ -370,10 +370,7 @@ void Odometry::add_retries(const SE3& prediction, double threshold, const Motion
   RegistrationConfig every_feature = registration_;
   every_feature.selection.method = SelectionMethod::kNone;
   // A coarse pass from each start with the initial (wide) threshold on every n-th feature ...
-  RegistrationConfig coarse_config = every_feature;
-  coarse_config.max_iterations = config_.retry_coarse_iterations;
-  coarse_config.convergence_translation_m = config_.retry_coarse_convergence_m;
-  coarse_config.convergence_rotation_rad = config_.retry_coarse_convergence_rad;
+  const RegistrationConfig coarse_config = coarse_registration();
   const StridedFeatures sparse(frame_features_, query_covariances(), config_.retry_coarse_stride);
   std::vector<RegistrationResult> coarse(starts.size());
   // Independent of each other (the maps are only read), so in parallel; each lands in its own slot.
@@ -392,6 +389,25 @@ void Odometry::add_retries(const SE3& prediction, double threshold, const Motion
   });
 }
 
+RegistrationConfig Odometry::coarse_registration() const {
+  RegistrationConfig coarse = registration_;
+  coarse.selection.method = SelectionMethod::kNone;
+  coarse.max_iterations = config_.retry_coarse_iterations;
+  coarse.convergence_translation_m = config_.retry_coarse_convergence_m;
+  coarse.convergence_rotation_rad = config_.retry_coarse_convergence_rad;
+  return coarse;
+}
+
+SE3 Odometry::registration_start(const SE3& prediction, double threshold) const {
+  if (config_.voxel_coarse_stride <= 1 || voxel_sample_share() <= 0.5) return prediction;
+  // The coarse pass keeps the prediction along a translation its features do not observe (scan_to_map), so the
+  // full registration from its end still holds the prediction's value there.
+  const StridedFeatures sparse(frame_features_, query_covariances(), static_cast<std::size_t>(config_.voxel_coarse_stride));
+  const RegistrationResult coarse = register_scan_to_map(sparse.edges, sparse.planes, edge_map_, plane_map_, prediction, threshold,
+                                                         coarse_registration(), nullptr, sparse.covariances());
+  return coarse.converged ? coarse.T_world_base : prediction;
+}
+
 RegistrationResult Odometry::register_robustly(const SE3& prediction, double centroid_stamp, const MotionDeskew* motion,
                                                FrameResult& frame) {
   const double threshold = error_count_ == 0
@@ -402,8 +418,9 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, double cen
   const TrustRule rule = trust_rule();
   frame.recent_residual_m = rule.recent_median_m;
   std::vector<RegistrationResult> candidates;
-  candidates.push_back(register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction, threshold,
-                                            registration_, motion, query_covariances()));
+  candidates.push_back(register_scan_to_map(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_,
+                                            registration_start(prediction, threshold), threshold, registration_, motion,
+                                            query_covariances()));
   // After a long gap the constant-velocity prediction says little, and one
   // alignment that fits is no evidence that it is the only one: the retries
   // run and decide, rivals included.

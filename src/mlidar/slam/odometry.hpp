@@ -88,6 +88,15 @@ struct OdometryConfig {
   int retry_coarse_iterations = 100;
   double retry_coarse_convergence_m = 0.01;
   double retry_coarse_convergence_rad = 1e-3;
+  /// A frame whose features are mostly voxel samples (ring-less keyframes, solid-state scanners) first registers
+  /// every n-th feature from the prediction with the retries' coarse settings, then every feature from where that
+  /// ended; 1: every feature from the prediction. Such frames come from keyframes up to a second apart whose
+  /// prediction may be decimetres and degrees off: from there the full registration took 13 iterations on average
+  /// (every one searching the map for every feature again), and 6 of 100 keyframes were retried. Real BALM keyframes 0.5 s apart, 2026-12-07 (docs/benchmarks.md "A coarse pass before
+  /// the full registration"): 4.7 full iterations, 1 retried frame instead of 6, whole run 7.3 -> 3.3 s, the same
+  /// pair errors. Range-image frames (10 Hz rigs, the prediction a few cm off) keep the prediction: there it
+  /// neither saved time nor changed the accuracy beyond noise.
+  int voxel_coarse_stride = 8;
   /// Frames this long after the previous one (seconds) always run the retries
   /// and are judged with their rivals, trusted first registration or not.
   double always_retry_after_s = 1.5;
@@ -223,6 +232,11 @@ class Odometry {
   /// `Xi_reg`: the registration's covariance (left, world) that uncertainty-aware mapping propagates.
   std::optional<MappingReport> update_map(const SE3& T_world_centroid, const LidarFeatures& features,
                                           const std::vector<FeatureBlock>& blocks, const Mat6& Xi_reg);
+  /// The retries' coarse pass settings (every feature of the strided set, the loose convergence).
+  RegistrationConfig coarse_registration() const;
+  /// Where the frame's full registration starts: the prediction, or for a frame of voxel samples the end of a
+  /// coarse pass from it (voxel_coarse_stride) when that converged.
+  SE3 registration_start(const SE3& prediction, double threshold) const;
   /// At the second frame, once a velocity is known: moves the world from the
   /// first frame's centroid pose to its stamp pose and rebuilds the map from
   /// the first two frames' features deskewed with that velocity.
