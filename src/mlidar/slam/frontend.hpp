@@ -44,7 +44,7 @@ struct FrontEndConfig {
   /// resets it; 0: search every scan. A scanner whose clouds show no rows (solid-state, sweeps merged while moving)
   /// keeps showing none, and each refused search costs 10-20 ms of a 75k-point cloud: on real BALM keyframes 87 of
   /// 100 are refused, a third of the run (docs/benchmarks.md "A coarse pass before the full registration").
-  int recover_rows_max_skip = 16;
+  int recover_rows_max_skip = 4;
   RowRecoveryConfig row_recovery;
 };
 
