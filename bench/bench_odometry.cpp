@@ -1,7 +1,7 @@
 // Odometry hot paths on simulated rv/campus scans (seeded): each front-end
 // stage on the top LiDAR, one scan-to-map registration, and whole frames with
 // 1-4 of the rv rig's LiDARs (issue 7's scaling, thesis Table 4.7); the scan
-// rows of real ring-less keyframes.
+// rows of real ring-less keyframes, and whole odometry over ten of them.
 #include <algorithm>
 #include <array>
 #include <filesystem>
@@ -264,6 +264,43 @@ void BM_OdometryFrame(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kFrames);  // items_per_second = frames per second
 }
 BENCHMARK(BM_OdometryFrame)->DenseRange(1, 4)->Unit(benchmark::kMillisecond);
+
+/// BALM keyframes 30..39 (0.5 s apart, taken while moving: voxel samples), read once; empty without the shared data.
+const std::vector<Frame>& balm_keyframes() {
+  static const std::vector<Frame> frames = [] {
+    std::vector<Frame> out;
+    const std::filesystem::path folder = std::filesystem::path(MLIDAR_SHARED_DATA) / "real" / "balm_ouster" / "frames";
+    for (int index = 30; index < 40; ++index) {
+      const std::filesystem::path file = folder / ("full" + std::to_string(index) + ".pcd");
+      if (!std::filesystem::exists(file)) return std::vector<Frame>{};
+      Frame frame;
+      frame.stamp = 0.5 * (index - 30);
+      frame.scans.push_back(io::to_scan(io::read_cloud(file).table, file.string()));
+      frame.scans.back().stamp = frame.stamp;
+      out.push_back(std::move(frame));
+    }
+    return out;
+  }();
+  return frames;
+}
+
+/// Odometry over ten real keyframes per iteration; arg = OdometryConfig::voxel_coarse_stride (1: every feature from
+/// the prediction; 8, the default: a coarse pass on every 8th first).
+void BM_RealKeyframes(benchmark::State& state) {
+  const std::vector<Frame>& frames = balm_keyframes();
+  if (frames.empty()) {
+    state.SkipWithError("shared data not found");
+    return;
+  }
+  OdometryConfig config;
+  config.voxel_coarse_stride = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    Odometry odometry(config, {{"ouster", LidarModel{}, SE3::identity()}});
+    for (const Frame& frame : frames) benchmark::DoNotOptimize(odometry.process(frame).T_world_base);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(frames.size()));  // keyframes per second
+}
+BENCHMARK(BM_RealKeyframes)->Arg(1)->Arg(8)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace mlidar::slam
