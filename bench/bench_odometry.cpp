@@ -65,12 +65,16 @@ void BM_RangeImage(benchmark::State& state) {
 }
 BENCHMARK(BM_RangeImage)->Unit(benchmark::kMillisecond);
 
+/// BALM's real Ouster keyframe `index` (shared data).
+std::filesystem::path balm_keyframe_file(int index) {
+  return std::filesystem::path(MLIDAR_SHARED_DATA) / "real" / "balm_ouster" / "frames" / ("full" + std::to_string(index) + ".pcd");
+}
+
 // Scan rows recovered from a real ring-less Ouster keyframe (BALM, ~75k
 // points): arg = keyframe; 20 is a single sweep (64 rows recovered), 60 merged
 // from sweeps taken while moving (refused after the same search).
 void BM_RecoverRows(benchmark::State& state) {
-  const std::filesystem::path file = std::filesystem::path(MLIDAR_SHARED_DATA) / "real" / "balm_ouster" / "frames" /
-                                     ("full" + std::to_string(state.range(0)) + ".pcd");
+  const std::filesystem::path file = balm_keyframe_file(static_cast<int>(state.range(0)));
   if (!std::filesystem::exists(file)) {
     state.SkipWithError("shared data not found");
     return;
@@ -269,9 +273,8 @@ BENCHMARK(BM_OdometryFrame)->DenseRange(1, 4)->Unit(benchmark::kMillisecond);
 const std::vector<Frame>& balm_keyframes() {
   static const std::vector<Frame> frames = [] {
     std::vector<Frame> out;
-    const std::filesystem::path folder = std::filesystem::path(MLIDAR_SHARED_DATA) / "real" / "balm_ouster" / "frames";
     for (int index = 30; index < 40; ++index) {
-      const std::filesystem::path file = folder / ("full" + std::to_string(index) + ".pcd");
+      const std::filesystem::path file = balm_keyframe_file(index);
       if (!std::filesystem::exists(file)) return std::vector<Frame>{};
       Frame frame;
       frame.stamp = 0.5 * (index - 30);

@@ -303,7 +303,7 @@ void Odometry::adapt_threshold(const SE3& prediction, const SE3& estimate) {
 
 RegistrationConfig Odometry::frame_registration(const SE3& prediction, double threshold, double centroid_stamp, FrameResult& frame) {
   RegistrationConfig config = config_.registration;
-  if (voxel_sample_share() > 0.5) config.plane_neighbors_max = config_.voxel_plane_neighbors_max;
+  if (mostly_voxel_samples()) config.plane_neighbors_max = config_.voxel_plane_neighbors_max;
   SelectionConfig& selection = config.selection;
   if (selection_paused_ || centroid_stamp - centroid_poses_.back().stamp > selection.max_frame_gap_s)
     selection.method = SelectionMethod::kNone;
@@ -399,7 +399,7 @@ RegistrationConfig Odometry::coarse_registration() const {
 }
 
 SE3 Odometry::registration_start(const SE3& prediction, double threshold) const {
-  if (config_.voxel_coarse_stride <= 1 || voxel_sample_share() <= 0.5) return prediction;
+  if (config_.voxel_coarse_stride <= 1 || !mostly_voxel_samples()) return prediction;
   // The coarse pass keeps the prediction along a translation its features do not observe (scan_to_map), so the
   // full registration from its end still holds the prediction's value there.
   const StridedFeatures sparse(frame_features_, query_covariances(), static_cast<std::size_t>(config_.voxel_coarse_stride));

@@ -92,10 +92,11 @@ struct OdometryConfig {
   /// every n-th feature from the prediction with the retries' coarse settings, then every feature from where that
   /// ended; 1: every feature from the prediction. Such frames come from keyframes up to a second apart whose
   /// prediction may be decimetres and degrees off: from there the full registration took 13 iterations on average
-  /// (every one searching the map for every feature again), and 6 of 100 keyframes were retried. Real BALM keyframes 0.5 s apart, 2026-12-07 (docs/benchmarks.md "A coarse pass before
-  /// the full registration"): 4.7 full iterations, 1 retried frame instead of 6, whole run 7.3 -> 3.3 s, the same
-  /// pair errors. Range-image frames (10 Hz rigs, the prediction a few cm off) keep the prediction: there it
-  /// neither saved time nor changed the accuracy beyond noise.
+  /// (every one searching the map for every feature again), and 6 of 100 keyframes were retried. Real BALM
+  /// keyframes 0.5 s apart, 2026-12-07 (docs/benchmarks.md "A coarse pass before the full registration"): 4.7 full
+  /// iterations, 1 retried frame instead of 6, whole run 7.3 -> 3.3 s, the same pair errors. Range-image frames
+  /// (10 Hz rigs, the prediction a few cm off) keep the prediction: there it neither saved time nor changed the
+  /// accuracy beyond noise.
   int voxel_coarse_stride = 8;
   /// Frames this long after the previous one (seconds) always run the retries
   /// and are judged with their rivals, trusted first registration or not.
@@ -210,6 +211,9 @@ class Odometry {
   double residual_scale() const;
   /// The current frame's share of voxel samples among its features, in [0, 1].
   double voxel_sample_share() const;
+  /// Most of the frame's features are voxel samples (clouds without a model or scan rows): they get their own
+  /// plane fit (voxel_plane_neighbors_max) and a coarse pass first (voxel_coarse_stride).
+  bool mostly_voxel_samples() const { return voxel_sample_share() > 0.5; }
   TrustRule trust_rule() const;
   /// The registration settings of this frame: the plane fit by its kind of features (voxel_plane_neighbors_max when
   /// mostly voxel samples); with adaptive feature selection,
