@@ -53,6 +53,25 @@ TEST(TrustRule, RelativeBoundHasAFloorAndNeedsAHistory) {
   EXPECT_FALSE(tight.trusted(candidate(0.031, 0.9)));
 }
 
+TEST(TrustRule, TheSecondFrameMayMatchFewerFeaturesOnlyWithATightWellConditionedFit) {
+  const slam::TrustConfig config;  // 0.5 of the features; 0.3 for the second frame within 0.06 m
+  const slam::TrustRule first{config, std::nan(""), true}, later{config, std::nan(""), false};
+  slam::RegistrationResult right = candidate(0.027, 0.46);  // the single RS-LiDAR-16's second frame at 7.5 m/s
+  right.converged = true;
+  EXPECT_TRUE(first.trusted(right));
+  EXPECT_FALSE(later.acceptable(right));
+  slam::RegistrationResult turned = right;  // a wrong alignment after a 120 deg turn
+  turned.mean_residual_m = 0.13;
+  EXPECT_FALSE(first.acceptable(turned));
+  slam::RegistrationResult sliding = right;
+  sliding.degenerate = true;
+  EXPECT_FALSE(first.acceptable(sliding));
+  slam::RegistrationResult unfinished = right;
+  unfinished.converged = false;
+  EXPECT_FALSE(first.acceptable(unfinished));
+  EXPECT_FALSE(first.acceptable(candidate(0.027, 0.29)));  // converged or not, too few
+}
+
 TEST(ChooseRegistration, KeepsTheTightestAcceptableAndJudgesIt) {
   const slam::TrustRule rule{slam::TrustConfig{}, 0.05};
   // The tightest of all is not acceptable (too few matches): the next one wins.

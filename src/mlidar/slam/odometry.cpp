@@ -328,7 +328,9 @@ double Odometry::voxel_sample_share() const {
 
 double Odometry::residual_scale() const { return 1.0 + (config_.trust.voxel_residual_ratio - 1.0) * voxel_sample_share(); }
 
-TrustRule Odometry::trust_rule() const { return {config_.trust, residual_scale() * recent_residuals_.median_m()}; }
+TrustRule Odometry::trust_rule() const {
+  return {config_.trust, residual_scale() * recent_residuals_.median_m(), centroid_poses_.size() == 1};
+}
 
 void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
   // Eq 4.12 again with the velocity from the previous centroid to this registration: the

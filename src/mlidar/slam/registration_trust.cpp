@@ -39,7 +39,10 @@ double ResidualHistory::median_m() const {
 }
 
 bool TrustRule::acceptable(const RegistrationResult& r) const {
-  return r.match_ratio() >= config.min_match_ratio && r.mean_residual_m <= config.max_mean_residual_m;
+  if (!(r.mean_residual_m <= config.max_mean_residual_m)) return false;
+  if (r.match_ratio() >= config.min_match_ratio) return true;
+  return first_sweep_map && r.match_ratio() >= config.first_match_ratio && r.converged && !r.degenerate &&
+         r.mean_residual_m <= config.first_max_residual_m;
 }
 
 double TrustRule::trusted_limit_m() const {

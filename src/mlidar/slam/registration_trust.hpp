@@ -22,6 +22,14 @@ namespace mlidar::slam {
 
 struct TrustConfig {
   double min_match_ratio = 0.5;       ///< acceptable: at least this share of features matched
+  /// ... or this share for the second frame, whose map is the first sweep alone, when its fit is tight and well
+  /// conditioned (converged, not degenerate, mean |r| at most first_max_residual_m): a 16-beam sweep leaves a
+  /// feature between its rings with too few neighbours for a plane (one RS-LiDAR-16 at 7.5 m/s: 0.46-0.47 matched
+  /// at the second frame, mean |r| 0.027 m, observability 0.21-0.27; 0.58-0.78 at the next frames; lost at 0.5, the
+  /// velocity never became known and every later frame was lost too). Wrong second frames after 120-180 deg turns
+  /// match 0.37-0.41 but at 0.13-0.15 m, observability 0.006.
+  double first_match_ratio = 0.3;
+  double first_max_residual_m = 0.06;
   double max_mean_residual_m = 0.2;   ///< acceptable: mean |r| at most this
   double residual_ratio = 2.0;        ///< trusted: mean |r| at most this x the recent median ...
   double residual_floor_m = 0.03;     ///< ... or at most this, whichever is larger
@@ -72,6 +80,7 @@ class ResidualHistory {
 struct TrustRule {
   TrustConfig config;
   double recent_median_m;  ///< NaN: no history yet (then acceptable is trusted)
+  bool first_sweep_map = false;  ///< the map holds the first frame alone (TrustConfig::first_match_ratio)
 
   bool acceptable(const RegistrationResult& r) const;
   bool trusted(const RegistrationResult& r) const;
