@@ -2,6 +2,7 @@
 // against Monte Carlo, the registration weight, eq 4.30's voxel filter on
 // cells worked by hand, the map keeping each point's covariance, and the
 // weighted registration against constructed planes.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -101,6 +102,36 @@ TEST(PointUncertainty, VoxelFilterOfEqualCovariancesIsTheCentroid) {
   EXPECT_LT((out[0].point - Eigen::Vector3f(0.2F, 0.2F, 0.1F)).norm(), 1e-6F);
   EXPECT_NEAR(out[0].covariance.trace(), 0.03 / 3.0, 1e-8);  // 3 x (1/3)^2 x 0.01 per axis
   EXPECT_THROW(covariance_voxel_filter(points, 0.0, 0.1), std::invalid_argument);
+}
+
+// What the filter is for (sec 4.8.2): a frame's noisy points on a surface, merged per cube, lie closer to it, and
+// the merged covariance still says how far (the normal's variance of the merged points against their spread).
+TEST(PointUncertainty, VoxelFilterThinsANoisyPlaneAndItsCovarianceFollows) {
+  const double sigma = 0.03;
+  const PointCovariance noise = PointCovariance::from(diagonal(sigma * sigma, sigma * sigma, sigma * sigma));
+  std::mt19937 engine(7);
+  std::uniform_real_distribution<float> across(0.0F, 4.0F);
+  std::normal_distribution<float> off_plane(0.0F, static_cast<float>(sigma));
+  std::vector<CovariantPoint> points(8000);
+  for (CovariantPoint& p : points) p = {{across(engine), across(engine), 0.1F + off_plane(engine)}, noise};
+  const std::vector<CovariantPoint> merged = covariance_voxel_filter(points, 0.2, 0.1);
+  // 4 x 4 m in 0.2 m cubes, the plane mid-way in z: 400 cubes of about 20 points, and a few single points beyond 3 sigma.
+  ASSERT_GT(merged.size(), 390u);
+  ASSERT_LT(merged.size(), 440u);
+  std::vector<double> offsets;
+  double normalized_sq = 0.0;
+  for (const CovariantPoint& p : merged) {
+    const double offset = p.point.z() - 0.1;
+    offsets.push_back(std::abs(offset));
+    normalized_sq += offset * offset / p.covariance.along(Vec3::UnitZ());
+  }
+  std::nth_element(offsets.begin(), offsets.begin() + offsets.size() / 2, offsets.end());
+  // The typical merged point lies several times closer to the plane than the noise (median of |N(0, 1)| is 0.67) ...
+  EXPECT_LT(offsets[offsets.size() / 2], 0.67 * sigma / 3.0);
+  // ... and the covariance it carries says so: its normalized offsets have variance 1 when honest.
+  const double variance = normalized_sq / static_cast<double>(merged.size());
+  EXPECT_GT(variance, 0.7);
+  EXPECT_LT(variance, 1.4);
 }
 
 TEST(PointUncertainty, VoxelFilterKeepsTheLidarOfEachCubesHeaviestPoint) {

@@ -1,5 +1,6 @@
 #include "mlidar/slam/point_uncertainty.hpp"
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -40,46 +41,68 @@ std::vector<PointCovariance> feature_covariances(std::span<const Eigen::Vector3f
   return out;
 }
 
-std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2) {
-  if (!(cube_m > 0.0)) throw std::invalid_argument("covariance_voxel_filter: cube edge must be > 0");
-  struct Cube {
-    double weight_sum = 0.0;  ///< sum of (w - tr Sigma_i) over its points
-    Vec3 mean = Vec3::Zero();
-    Mat3 covariance = Mat3::Zero();
-    double heaviest_weight = -1.0;
-    std::uint8_t source = 255;  ///< of the heaviest point
-  };
-  const double inv = 1.0 / cube_m;
-  const auto raw_weight = [trace_threshold_m2](const CovariantPoint& p) {
-    return std::max(0.0, trace_threshold_m2 - p.covariance.trace());
-  };
+namespace {
+
+/// One cube of eq 4.30 with the raw weights r_i = w - tr(Sigma_i): w_i = r_i / sum r, so its mean is
+/// sum(r_i y_i) / sum r and its covariance sum(r_i^2 Sigma_i) / (sum r)^2.
+struct Cube {
+  double weight_sum = 0.0;
+  Vec3 weighted_points = Vec3::Zero();
+  std::array<double, 6> weighted_covariance{};  ///< sum r_i^2 Sigma_i, upper triangle as PointCovariance
+  double heaviest_weight = -1.0;
+  std::uint8_t source = 255;  ///< of the heaviest point
+};
+
+}  // namespace
+
+struct VoxelFilterWorkspace::Buffers {
   tsl::robin_map<VoxelKey, std::size_t, VoxelKeyHash> index;
   std::vector<Cube> cubes;
-  std::vector<std::size_t> cube_of(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const auto [it, added] = index.try_emplace(voxel_key(points[i].point, inv), cubes.size());
+};
+
+VoxelFilterWorkspace::VoxelFilterWorkspace() : buffers_(std::make_unique<Buffers>()) {}
+VoxelFilterWorkspace::~VoxelFilterWorkspace() = default;
+VoxelFilterWorkspace::VoxelFilterWorkspace(VoxelFilterWorkspace&&) noexcept = default;
+VoxelFilterWorkspace& VoxelFilterWorkspace::operator=(VoxelFilterWorkspace&&) noexcept = default;
+
+std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2,
+                                                    VoxelFilterWorkspace& workspace) {
+  if (!(cube_m > 0.0)) throw std::invalid_argument("covariance_voxel_filter: cube edge must be > 0");
+  const double inv = 1.0 / cube_m;
+  auto& [index, cubes] = *workspace.buffers_;
+  index.clear();
+  cubes.clear();
+  for (const CovariantPoint& p : points) {
+    const auto [it, added] = index.try_emplace(voxel_key(p.point, inv), cubes.size());
     if (added) cubes.emplace_back();
-    cube_of[i] = it->second;
     Cube& cube = cubes[it->second];
-    const double weight = raw_weight(points[i]);
-    cube.weight_sum += weight;
+    const double weight = std::max(0.0, trace_threshold_m2 - p.covariance.trace());
     if (weight > cube.heaviest_weight) {
       cube.heaviest_weight = weight;
-      cube.source = points[i].source;
+      cube.source = p.source;
     }
-  }
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    Cube& cube = cubes[cube_of[i]];
-    if (!(cube.weight_sum > 0.0)) continue;
-    const double w = raw_weight(points[i]) / cube.weight_sum;  // eq 4.30's normalized weight
-    cube.mean += w * points[i].point.cast<double>();
-    cube.covariance += (w * w) * points[i].covariance.matrix();
+    if (weight == 0.0) continue;
+    cube.weight_sum += weight;
+    cube.weighted_points += weight * p.point.cast<double>();
+    for (std::size_t k = 0; k < 6; ++k) cube.weighted_covariance[k] += weight * weight * static_cast<double>(p.covariance.upper[k]);
   }
   std::vector<CovariantPoint> out;
   out.reserve(cubes.size());
-  for (const Cube& cube : cubes)
-    if (cube.weight_sum > 0.0) out.push_back({cube.mean.cast<float>(), PointCovariance::from(cube.covariance), cube.source});
+  for (const Cube& cube : cubes) {
+    if (!(cube.weight_sum > 0.0)) continue;  // only points with tr(Sigma) >= w
+    CovariantPoint merged;
+    merged.point = (cube.weighted_points / cube.weight_sum).cast<float>();
+    const double scale = 1.0 / (cube.weight_sum * cube.weight_sum);
+    for (std::size_t k = 0; k < 6; ++k) merged.covariance.upper[k] = static_cast<float>(scale * cube.weighted_covariance[k]);
+    merged.source = cube.source;
+    out.push_back(merged);
+  }
   return out;
+}
+
+std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2) {
+  VoxelFilterWorkspace workspace;
+  return covariance_voxel_filter(points, cube_m, trace_threshold_m2, workspace);
 }
 
 }  // namespace mlidar::slam
