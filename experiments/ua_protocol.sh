@@ -13,10 +13,12 @@
 #   inj_ua   injected extrinsic given with covariance diag(0.1^2 m^2 x3, (10 deg)^2 x3), alpha = 10
 #   base     the base LiDAR alone (`mlidar odometry --lidars BASE`): what ignoring the auxiliary LiDAR gives
 # and the estimator's ms per frame of true_wo and true_ua.
-#   experiments/ua_protocol.sh BUILD_DIR FRAMES SEEDS WORK_DIR [DATASETS (default: campus room rv)]
+#   experiments/ua_protocol.sh BUILD_DIR FRAMES SEEDS WORK_DIR [DATASETS (default: campus room rv)] [VOXEL_FILTER_M]
+# VOXEL_FILTER_M: mapping.voxel_filter_m of the aware runs (eq 4.30; default: the configuration's).
 set -euo pipefail
 build=${1:?BUILD_DIR}; frames=${2:?FRAMES}; seeds=${3:?SEEDS}; work=${4:?WORK_DIR}
 datasets=${5:-"campus room rv"}
+voxel_filter=${6:+", voxel_filter_m: $6"}
 mlidar="$build/apps/mlidar/mlidar"
 mkdir -p "$work"
 cat > "$work/rv_top_front.yaml" <<YAML
@@ -28,10 +30,10 @@ lidars:
   - {name: front, model: RS-LiDAR-16, translation: [0.795, 0, -1.364], rotation_rpy_deg: [0, 10, 0]}
 YAML
 cat > "$work/aware_alpha1.yaml" <<YAML
-mapping: {uncertainty_aware: true}
+mapping: {uncertainty_aware: true$voxel_filter}
 YAML
 cat > "$work/aware_alpha10.yaml" <<YAML
-mapping: {uncertainty_aware: true}
+mapping: {uncertainty_aware: true$voxel_filter}
 window: {extrinsic_covariance_scale: 10}
 YAML
 
@@ -61,8 +63,10 @@ yaml.safe_dump({"base": truth["base"], "lidars": lidars}, open(out, "w"), defaul
 PY
 }
 
-ate() { "$mlidar" eval traj --gt "$1/groundtruth/trajectory.tum" --est "$2/trajectory.tum" --json "$2/traj.json" > /dev/null
-        jq '.ate.translation_m.rmse' "$2/traj.json"; }
+# ATE RMSE, or nan when the run has no trajectory to align (every frame lost: the pose never moved).
+ate() { if "$mlidar" eval traj --gt "$1/groundtruth/trajectory.tum" --est "$2/trajectory.tum" --json "$2/traj.json" > /dev/null 2>&1
+        then jq '.ate.translation_m.rmse' "$2/traj.json"; else echo nan; fi; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a == "nan" || b == "nan") print "nan"; else printf "%.2f", a / b }'; }
 ms() { jq '.total_seconds.mean * 1000' "$1/metrics.json" 2> /dev/null || jq '.seconds.total.mean * 1000' "$1/metrics.json"; }
 
 echo "| dataset | seed | true_wo | true_ua (a=1) | inj_wo | inj_ua (a=10) | base alone | inj_ua / true_wo | true_ua / true_wo | ms true_wo / true_ua |"
@@ -96,9 +100,9 @@ for dataset in $datasets; do
     out="$work/r_${dataset}_${seed}_base"; rm -rf "$out"
     "$mlidar" odometry --dataset "$sim" --lidars "$base" --threads 1 --out "$out" > /dev/null 2>&1 || true
     result[base]=$(ate "$sim" "$out")
-    printf "| %s | %s | %.4f | %.4f | %.4f | %.4f | %.4f | %.2f | %.2f | %.1f / %.1f |\n" "$dataset" "$seed" \
+    printf "| %s | %s | %.4f | %.4f | %.4f | %.4f | %.4f | %s | %s | %.1f / %.1f |\n" "$dataset" "$seed" \
       "${result[true_wo]}" "${result[true_ua]}" "${result[inj_wo]}" "${result[inj_ua]}" "${result[base]}" \
-      "$(echo "${result[inj_ua]} / ${result[true_wo]}" | bc -l)" "$(echo "${result[true_ua]} / ${result[true_wo]}" | bc -l)" \
+      "$(ratio "${result[inj_ua]}" "${result[true_wo]}")" "$(ratio "${result[true_ua]}" "${result[true_wo]}")" \
       "$(ms "$work/r_${dataset}_${seed}_true_wo")" "$(ms "$work/r_${dataset}_${seed}_true_ua")"
     unset result
   done
