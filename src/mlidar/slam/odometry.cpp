@@ -262,8 +262,8 @@ std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, c
         drop_uncertain(ua.trace_threshold_m2, edges, traces) + drop_uncertain(ua.trace_threshold_m2, planes, traces);
     report->median_trace_m2 = traces.empty() ? 0.0 : median(traces);
     if (ua.voxel_filter_m > 0.0) {
-      edges = covariance_voxel_filter(edges, ua.voxel_filter_m, ua.trace_threshold_m2, voxel_filter_workspace_);
-      planes = covariance_voxel_filter(planes, ua.voxel_filter_m, ua.trace_threshold_m2, voxel_filter_workspace_);
+      edges = covariance_voxel_filter(edges, ua.voxel_filter_m, ua.trace_threshold_m2);
+      planes = covariance_voxel_filter(planes, ua.voxel_filter_m, ua.trace_threshold_m2);
     }
     report->points_added = edges.size() + planes.size();
     edge_map_.add(edges);

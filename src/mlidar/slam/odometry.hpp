@@ -257,7 +257,6 @@ class Odometry {
   std::optional<QueryCovariances> query_covariances_;
   VoxelMap edge_map_;
   VoxelMap plane_map_;
-  VoxelFilterWorkspace voxel_filter_workspace_;  ///< eq 4.30's buffers, reused frame to frame
   std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid
   /// Mean |r| of the last registered (not lost) frames, each divided by its
   /// frame's residual_scale().

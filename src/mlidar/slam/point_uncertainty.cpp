@@ -55,23 +55,11 @@ struct Cube {
 
 }  // namespace
 
-struct VoxelFilterWorkspace::Buffers {
-  tsl::robin_map<VoxelKey, std::size_t, VoxelKeyHash> index;
-  std::vector<Cube> cubes;
-};
-
-VoxelFilterWorkspace::VoxelFilterWorkspace() : buffers_(std::make_unique<Buffers>()) {}
-VoxelFilterWorkspace::~VoxelFilterWorkspace() = default;
-VoxelFilterWorkspace::VoxelFilterWorkspace(VoxelFilterWorkspace&&) noexcept = default;
-VoxelFilterWorkspace& VoxelFilterWorkspace::operator=(VoxelFilterWorkspace&&) noexcept = default;
-
-std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2,
-                                                    VoxelFilterWorkspace& workspace) {
+std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2) {
   if (!(cube_m > 0.0)) throw std::invalid_argument("covariance_voxel_filter: cube edge must be > 0");
   const double inv = 1.0 / cube_m;
-  auto& [index, cubes] = *workspace.buffers_;
-  index.clear();
-  cubes.clear();
+  tsl::robin_map<VoxelKey, std::size_t, VoxelKeyHash> index;
+  std::vector<Cube> cubes;
   for (const CovariantPoint& p : points) {
     const auto [it, added] = index.try_emplace(voxel_key(p.point, inv), cubes.size());
     if (added) cubes.emplace_back();
@@ -98,11 +86,6 @@ std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoi
     out.push_back(merged);
   }
   return out;
-}
-
-std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2) {
-  VoxelFilterWorkspace workspace;
-  return covariance_voxel_filter(points, cube_m, trace_threshold_m2, workspace);
 }
 
 }  // namespace mlidar::slam

@@ -17,7 +17,6 @@
 // with tr(Sigma) > w are dropped and the rest downsampled by eq 4.30.
 #include <array>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <vector>
 
@@ -67,28 +66,10 @@ struct CovariantPoint {
   std::uint8_t source = 255;  ///< the LiDAR that saw it (its index), 255 when unknown
 };
 
-/// The buffers covariance_voxel_filter keeps between calls: a frame's filter then allocates nothing new
-/// (6000 points: 0.87 -> 0.27 ms on the 2-core VM, most of it page faults of fresh buffers).
-class VoxelFilterWorkspace {
- public:
-  VoxelFilterWorkspace();
-  ~VoxelFilterWorkspace();
-  VoxelFilterWorkspace(VoxelFilterWorkspace&&) noexcept;
-  VoxelFilterWorkspace& operator=(VoxelFilterWorkspace&&) noexcept;
-
- private:
-  friend std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint>, double, double, VoxelFilterWorkspace&);
-  struct Buffers;
-  std::unique_ptr<Buffers> buffers_;
-};
-
 /// Eq 4.30: the points grouped by cubes of edge `cube_m` (> 0); each cube becomes one point
 /// y = sum w_i y_i, Sigma = sum w_i^2 Sigma_i with w_i = (w - tr Sigma_i) / sum_j (w - tr Sigma_j).
 /// Points with tr(Sigma) >= w carry no weight; a cube of only those is dropped. Output in the order each
 /// cube's first point came; its source is that of the cube's heaviest point (the first of equals).
-std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2,
-                                                    VoxelFilterWorkspace& workspace);
-/// The same with buffers of its own.
 std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoint> points, double cube_m, double trace_threshold_m2);
 
 }  // namespace mlidar::slam
