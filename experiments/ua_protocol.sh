@@ -29,12 +29,19 @@ lidars:
   - {name: top, model: RS-LiDAR-16, translation: [0, 0, 0], rotation_rpy_deg: [0, 0, 0]}
   - {name: front, model: RS-LiDAR-16, translation: [0.795, 0, -1.364], rotation_rpy_deg: [0, 10, 0]}
 YAML
+# The given-extrinsic check (extrinsic_check, which would calibrate the injected LiDAR from the first frame) is off
+# in every run: the protocol measures what the mapping does with a wrong extrinsic, calibration off.
+cat > "$work/unaware.yaml" <<YAML
+extrinsic_check: {residual_ratio: 0}
+YAML
 cat > "$work/aware_alpha1.yaml" <<YAML
 mapping: {uncertainty_aware: true$voxel_filter}
+extrinsic_check: {residual_ratio: 0}
 YAML
 cat > "$work/aware_alpha10.yaml" <<YAML
 mapping: {uncertainty_aware: true$voxel_filter}
 window: {extrinsic_covariance_scale: 10}
+extrinsic_check: {residual_ratio: 0}
 YAML
 
 # write_extrinsics TRUTH OUT INJECT(0|1): the auxiliary LiDARs' extrinsics from the simulator's truth.
@@ -89,9 +96,9 @@ for dataset in $datasets; do
     for run in true_wo true_ua inj_wo inj_ua; do
       out="$work/r_${dataset}_${seed}_$run"; rm -rf "$out"
       case "$run" in
-        true_wo) args=(--extrinsics "$sim/true.yaml") ;;
+        true_wo) args=(--extrinsics "$sim/true.yaml" --config "$work/unaware.yaml") ;;
         true_ua) args=(--extrinsics "$sim/true.yaml" --config "$work/aware_alpha1.yaml") ;;
-        inj_wo) args=(--extrinsics "$sim/inj.yaml") ;;
+        inj_wo) args=(--extrinsics "$sim/inj.yaml" --config "$work/unaware.yaml") ;;
         inj_ua) args=(--extrinsics "$sim/inj.yaml" --config "$work/aware_alpha10.yaml") ;;
       esac
       "$mlidar" slam --dataset "$sim" --calibrate fixed --threads 1 "${args[@]}" --out "$out" > /dev/null 2>&1 || true

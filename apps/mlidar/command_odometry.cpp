@@ -1,4 +1,5 @@
 // `mlidar odometry`: multi-LiDAR scan-to-map odometry over a dataset or a folder of clouds.
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -75,7 +76,12 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
   if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';
-  return summary.lost_frames > 0 || summary.base_failure ? 1 : 0;
+  for (const pipelines::GivenExtrinsicDisagreement& d : summary.disagreements)
+    std::cerr << "warning: " << d.lidar << ": the given extrinsic disagrees with the map (at frame " << d.frame << " its residual was "
+              << std::lround(d.residual_ratio * 10.0) / 10.0 << "x the base's, the median of the last extrinsic_check.frames frames; "
+              << "right extrinsics stay near 1): the trajectory and map may be wrong; check it, or calibrate it with "
+              << "`mlidar slam --calibrate refine`\n";
+  return summary.trusted() ? 0 : 1;
 }
 
 }  // namespace

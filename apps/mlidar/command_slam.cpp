@@ -1,12 +1,15 @@
 // `mlidar slam`: the M-LOAM back end: odometry with online extrinsic calibration of every LiDAR.
 #include <cmath>
+#include <iomanip>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "apps/mlidar/bag_options.hpp"
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/pipelines/slam_job.hpp"
 #include "mlidar/report/run_report.hpp"
@@ -59,6 +62,37 @@ void print_lidar(const pipelines::SlamLidarReport& lidar) {
     std::cout << "    weakly observed: " << weak.description << " (information " << weak.eigenvalue << ")\n";
 }
 
+/// A given extrinsic that disagreed with the map (calib::ExtrinsicCheck), in words; empty when none did.
+std::string disagreement_warning(const pipelines::SlamLidarReport& lidar) {
+  if (!lidar.disagreement) return "";
+  const pipelines::ExtrinsicDisagreement& d = *lidar.disagreement;
+  std::ostringstream text;
+  text << std::setprecision(2) << std::fixed;
+  text << "warning: " << lidar.name << ": the given extrinsic disagrees with the map ";
+  if (d.frames_lost)
+    text << "(no frame after the first could be registered with the given extrinsics, " << pipelines::SlamEstimator::kLostFromStartFrames
+         << " lost in a row: any of them may be wrong); ";
+  else
+    text << "(at frame " << d.frame << " its residual was " << d.residual_ratio
+         << "x the base's, the median of the last extrinsic_check.frames frames; right extrinsics stay near 1); ";
+  if (!d.recalibrated) {
+    text << "the run used it as given, its trajectory and map may be wrong: check it, or run --calibrate refine\n";
+    return text.str();
+  }
+  text << "calibrated online from it instead";
+  if (d.from_first_frame) text << ", the run started again from the first frame";
+  if (d.after_shock) text << " from there on (after its extrinsic shock: the mounting moved during the run)";
+  if (lidar.role == pipelines::LidarRole::trusted) {
+    const SE3 T_given_current = lidar.given_T_base_lidar.inverse() * lidar.T_base_lidar;
+    text << ": converged at frame " << lidar.converged_frame.value_or(0) << ", "
+         << rad_to_deg(Eigen::AngleAxisd(T_given_current.rotation()).angle()) << " deg / " << T_given_current.translation().norm()
+         << " m from the given one (extrinsics.yaml); fix the extrinsics file\n";
+  } else {
+    text << ": it did not converge (its extrinsic in extrinsics.yaml has no covariance)\n";
+  }
+  return text.str();
+}
+
 struct SlamOptions {
   pipelines::SlamJob job;
   BagCliOptions bag;
@@ -96,7 +130,8 @@ int run_slam(SlamOptions options, const CliContext& context) {
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
   if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';
-  return summary.all_converged() && summary.lost_frames == 0 && !summary.base_failure ? 0 : 1;
+  for (const auto& lidar : summary.lidars) std::cerr << disagreement_warning(lidar);
+  return summary.trusted() ? 0 : 1;
 }
 
 }  // namespace

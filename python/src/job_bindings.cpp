@@ -91,7 +91,7 @@ py::dict run_odometry(const RunOptions& run_options, const std::filesystem::path
   py::dict result = trajectory_summary(summary, out);
   result["degenerate_frames"] = summary.degenerate_frames;
   result["front_end"] = summary.front_end;
-  result["exit_code"] = summary.lost_frames > 0 || summary.base_failure ? 1 : 0;
+  result["exit_code"] = summary.trusted() ? 0 : 1;
   return result;
 }
 
@@ -138,7 +138,8 @@ py::dict run_slam(const RunOptions& run_options, const std::filesystem::path& da
   }
   result["lidars"] = lidars;
   result["all_converged"] = summary.all_converged();
-  result["exit_code"] = summary.all_converged() && summary.lost_frames == 0 && !summary.base_failure ? 0 : 1;
+  result["extrinsic_disagreed"] = summary.extrinsic_disagreed();
+  result["exit_code"] = summary.trusted() ? 0 : 1;
   return result;
 }
 

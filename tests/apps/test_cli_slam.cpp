@@ -5,7 +5,8 @@
 // changes nothing; fixed mode with the true extrinsics is the odometry; a
 // LiDAR with missing scans is reported and the run carries on; a bad config
 // key exits 3 and writes nothing; an injected extrinsic shock (Table 4.6) is
-// detected within a few frames; planar (vehicle) motion starts from what is
+// detected within a few frames, and a wrong given extrinsic is found and
+// calibrated from the first frame; planar (vehicle) motion starts from what is
 // observable and reports the rest.
 #include <algorithm>
 #include <array>
@@ -272,9 +273,10 @@ TEST(CliSlam, ExtrinsicShockIsDetectedAtItsFrame) {
   shift_mounting(sim / "scans" / "right", kShockFrame, kShockFrames, SE3::exp(delta));
   const fs::path run = dir / "run";
   const CliResult result = run_cli("slam --dataset " + quoted(truth.string()) + " --calibrate fixed --out " + quoted(run.string()));
-  // Exit 0 (measured): in fixed mode every LiDAR is trusted from the start, so there is no calibration to
-  // converge, and no frame is lost; the shock is reported in metrics.json, not in the exit code.
-  ASSERT_EQ(result.exit_code, 0) << result.output;
+  // Exit 1: the given extrinsic disagrees with the map after the shock (calib::ExtrinsicCheck); the LiDAR is
+  // calibrated from there on (not from the first frame: it was right before the shock) and has not converged by the end.
+  ASSERT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_NE(result.output.find("after its extrinsic shock"), std::string::npos) << result.output;
   const auto metrics = read_metrics(run);
   EXPECT_TRUE(metrics["per_lidar"]["left"]["shock_frames"].empty()) << metrics["per_lidar"]["left"]["shock_frames"];
   const auto& shocks = metrics["per_lidar"]["right"]["shock_frames"];
@@ -282,6 +284,68 @@ TEST(CliSlam, ExtrinsicShockIsDetectedAtItsFrame) {
   // The trigger needs `consecutive` (5) high frames in a row.
   EXPECT_GE(shocks.front().get<int>(), kShockFrame);
   EXPECT_LE(shocks.front().get<int>(), kShockFrame + 8);
+  const auto& check = metrics["per_lidar"]["right"]["extrinsic_check"];
+  ASSERT_TRUE(check.is_object()) << check;
+  EXPECT_TRUE(check["after_shock"].get<bool>());
+  EXPECT_FALSE(check["from_first_frame"].get<bool>());
+  EXPECT_GT(check["disagreed_frame"].get<int>(), shocks.front().get<int>());
+}
+
+TEST(CliSlam, AWrongGivenExtrinsicIsFoundAndCalibratedFromTheFirstFrame) {
+  // Fixed mode given Table 4.6's shock on the right LiDAR from the start (10 deg about each axis, 0.1 m along each).
+  // Measured (seed 1, 100 frames): its residual 3.1-4.4x the base's from frame 20 (right extrinsics 0.6-1.1x on the
+  // simulated rigs); used as given the trajectory is 4x worse than the true run's with no warning; calibrated from
+  // the first frame it is the true run's.
+  constexpr int kWrongFrames = 100;
+  const fs::path dir = scratch_dir();
+  const fs::path sim = simulate(dir, kWrongFrames, "0,0");
+  const fs::path truth = dataset_variant(sim, dir / "truth", false, true);
+  const double deg = 0.017453292519943295;
+  Vec6 shock;
+  shock << 0.1, 0.1, 0.1, 10 * deg, 10 * deg, 10 * deg;
+  io::Extrinsics wrong = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
+  const SE3 T_base_right = wrong.find("right")->T_base_lidar;
+  for (auto& lidar : wrong.lidars)
+    if (lidar.name == "right") lidar.T_base_lidar = T_base_right * SE3::exp(shock);
+  io::write_extrinsics(dir / "wrong.yaml", wrong);
+  const Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");
+  const std::string common = "slam --dataset " + quoted(truth.string()) + " --calibrate fixed --threads 1 ";
+
+  const fs::path right_run = dir / "right";
+  ASSERT_EQ(run_cli(common + "--out " + quoted(right_run.string())).exit_code, 0);
+  const double right_ate = ate_rmse(gt, io::read_tum(right_run / "trajectory.tum"));
+  EXPECT_TRUE(read_metrics(right_run)["per_lidar"]["right"]["extrinsic_check"].is_null());
+
+  std::ofstream(dir / "report_only.yaml") << "extrinsic_check:\n  recalibrate: false\n";
+  const fs::path as_given = dir / "as_given";
+  const CliResult reported = run_cli(common + "--extrinsics " + quoted((dir / "wrong.yaml").string()) + " --config " +
+                                     quoted((dir / "report_only.yaml").string()) + " --out " + quoted(as_given.string()));
+  EXPECT_EQ(reported.exit_code, 1) << reported.output;
+  EXPECT_NE(reported.output.find("right: the given extrinsic disagrees with the map"), std::string::npos) << reported.output;
+  EXPECT_NE(reported.output.find("the run used it as given"), std::string::npos) << reported.output;
+  const double as_given_ate = ate_rmse(gt, io::read_tum(as_given / "trajectory.tum"));
+  EXPECT_GT(as_given_ate, 2.0 * right_ate);  // the silent error the check is for
+
+  const fs::path calibrated = dir / "calibrated";
+  const CliResult result =
+      run_cli(common + "--extrinsics " + quoted((dir / "wrong.yaml").string()) + " --out " + quoted(calibrated.string()));
+  EXPECT_EQ(result.exit_code, 1) << result.output;  // the input was wrong: the user has to look
+  EXPECT_NE(result.output.find("the run started again from the first frame"), std::string::npos) << result.output;
+  const auto metrics = read_metrics(calibrated);
+  const auto& check = metrics["per_lidar"]["right"]["extrinsic_check"];
+  ASSERT_TRUE(check.is_object()) << check;
+  EXPECT_EQ(check["disagreed_frame"].get<int>(), 20);  // the first full median of 20 ratios (frame 0 registers nothing)
+  EXPECT_GT(check["residual_ratio"].get<double>(), 2.0);
+  EXPECT_TRUE(check["from_first_frame"].get<bool>());
+  EXPECT_EQ(metrics["per_frame"].size(), static_cast<std::size_t>(kWrongFrames));  // the whole run, once
+  EXPECT_EQ(metrics["per_frame"][0]["lidars"]["right"]["role"], "calibrating");
+  EXPECT_LT(ate_rmse(gt, io::read_tum(calibrated / "trajectory.tum")), 1.5 * right_ate);
+  if (metrics["per_lidar"]["right"]["role"] == "trusted") {
+    const io::Extrinsics estimated = io::read_extrinsics(calibrated / "extrinsics.yaml");
+    const SE3& T_estimated = estimated.find("right")->T_base_lidar;
+    EXPECT_LT(rotation_error_deg(T_base_right, T_estimated), kMaxRotationDeg);
+    EXPECT_LT(translation_error_m(T_base_right, T_estimated), kMaxTranslationM);
+  }
 }
 
 TEST(CliSlam, PlanarMotionStartsFromWhatIsObservableAndSaysWhich) {

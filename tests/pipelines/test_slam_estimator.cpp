@@ -1,7 +1,7 @@
 // The M-LOAM estimator in process, on simulated frames made in memory: its
 // per-LiDAR states and their transitions (initializing -> calibrating ->
-// trusted, a shock back to initializing), a LiDAR missing for 10 s, and the
-// planar-motion start.
+// trusted, a shock back to initializing), a LiDAR missing for 10 s, the
+// planar-motion start, and given extrinsics with which no frame registers.
 #include <algorithm>
 #include <functional>
 #include <optional>
@@ -35,17 +35,19 @@ struct Drive {
   std::uint64_t seed = 1;
 };
 
-Drive make_drive(const std::string& rig_name, const std::string& scene, const std::string& trajectory, int frames) {
+/// `scene_frames` (0: frames): the scene is laid out along that many frames' path, as `simulate drive --frames` does.
+Drive make_drive(const std::string& rig_name, const std::string& scene, const std::string& trajectory, int frames, std::uint64_t seed = 1,
+                 int scene_frames = 0) {
   sim::SimRig rig = sim::named_rig(rig_name);
   const sim::SimTrajectory path = sim::SimTrajectory::named(trajectory, rig.base_height);
   std::vector<double> stamps;
   std::vector<Vec3> positions;
-  for (int k = 0; k <= frames; ++k) {
+  for (int k = 0; k <= std::max(frames, scene_frames); ++k) {
     if (k < frames) stamps.push_back(path.start_time() + 0.1 * k);
     positions.push_back(path.T_world_base(path.start_time() + 0.1 * k).translation());
   }
-  sim::Scene world = sim::make_scene(scene, 1, positions);
-  return {std::move(rig), path, std::move(stamps), std::move(world)};
+  sim::Scene world = sim::make_scene(scene, seed, positions);
+  return {std::move(rig), path, std::move(stamps), std::move(world), seed};
 }
 
 /// LiDAR i's scan at frame k as the frame source gives it (stamp at its earliest point, times from there).
@@ -226,6 +228,54 @@ TEST(SlamEstimator, PlanarMotionStartsFromTheObservableDirectionsAndNamesTheOthe
   // The planar start is close enough for the window (its gates are 1.0 / 0.3 m).
   EXPECT_LT(translation_error_m(drive.rig.lidars[1].T_base_lidar, report.T_base_lidar), 0.3);
   EXPECT_LT(rotation_error_deg(drive.rig.lidars[1].T_base_lidar, report.T_base_lidar), 2.0);
+}
+
+TEST(SlamEstimator, NoFrameRegisteredWithTheGivenExtrinsicsSendsThemToCalibration) {
+  // rv's top and front on the scene of `simulate drive --frames 300 --seed 2`, the front given with Table 4.6's
+  // shock (10 deg about each axis, 0.1 m along each), fixed: at 7.5 m/s every frame after the first is lost
+  // (measured: 299 of 300 with the check off), so the residual ratio never sees a frame.
+  constexpr std::size_t kFrames = 12;
+  Drive drive = make_drive("rv", "campus", "vehicle", static_cast<int>(kFrames), 2, 300);
+  drive.rig.lidars.resize(2);
+  std::vector<slam::LidarSetup> given;
+  for (const sim::SimLidar& lidar : drive.rig.lidars) given.push_back({lidar.name, lidar.model, lidar.T_base_lidar});
+  const double angle = deg_to_rad(10.0);
+  given[1].T_base_lidar = SE3(given[1].T_base_lidar.rotation() * so3_exp(Vec3(angle, angle, angle)),
+                              given[1].T_base_lidar.translation() + Vec3(0.1, 0.1, 0.1));
+  const auto scan_of = [&](std::size_t k, std::size_t i, const sim::SimLidar& lidar) { return std::optional(sweep(drive, lidar, k, i)); };
+
+  pipelines::SlamConfig unchecked;
+  unchecked.extrinsic_check.residual_ratio = 0.0;
+  SlamEstimator as_given(unchecked, given, ExtrinsicSource::fixed);
+  const std::vector<SlamFrame> lost = run(as_given, drive, scan_of);
+  for (std::size_t k = 1; k < kFrames; ++k) EXPECT_TRUE(lost[k].lost) << "frame " << k << ": not the case this test is about";
+
+  SlamEstimator checked(pipelines::SlamConfig{}, given, ExtrinsicSource::fixed);
+  const std::vector<SlamFrame> frames = run(checked, drive, scan_of);
+  const std::size_t verdict = SlamEstimator::kLostFromStartFrames;
+  for (std::size_t k = 1; k <= verdict; ++k) EXPECT_TRUE(frames[k].lost) << "frame " << k;
+  EXPECT_TRUE(frames[verdict].lidars[1].extrinsic_disagrees);
+  EXPECT_TRUE(frames[verdict].trusted_changed);
+  const auto& disagreement = checked.track(1).disagreement();
+  ASSERT_TRUE(disagreement.has_value());
+  EXPECT_TRUE(disagreement->frames_lost);
+  EXPECT_TRUE(disagreement->recalibrated);
+  EXPECT_EQ(disagreement->frame, verdict);
+  EXPECT_EQ(frames[verdict].lidars[1].role, LidarRole::calibrating);
+  // Told from the first frame (what `mlidar slam` does next: the run started again), the base registers alone
+  // while the front calibrates, every frame near the truth; the LiDAR is not judged again.
+  SlamEstimator told(pipelines::SlamConfig{}, given, ExtrinsicSource::fixed,
+                     {std::nullopt, pipelines::ExtrinsicDisagreement{.frame = verdict, .residual_ratio = -1.0, .frames_lost = true}});
+  const std::vector<SlamFrame> from_start = run(told, drive, scan_of);
+  EXPECT_EQ(from_start[0].lidars[1].role, LidarRole::calibrating);
+  const SE3 T_first_world = drive.trajectory.T_world_base(drive.stamps[0]).inverse();
+  for (std::size_t k = 1; k < kFrames; ++k) {
+    EXPECT_FALSE(from_start[k].lost) << "frame " << k;
+    EXPECT_FALSE(from_start[k].lidars[1].extrinsic_disagrees) << "frame " << k;
+    const SE3 truth = T_first_world * drive.trajectory.T_world_base(drive.stamps[k]);
+    EXPECT_LT(translation_error_m(truth, from_start[k].T_world_base), 0.05) << "frame " << k;
+  }
+  EXPECT_TRUE(told.track(1).disagreement()->from_first_frame);
 }
 
 /// A config under which the hand-eye never starts a LiDAR: its translation is never certain enough, and the

@@ -1,5 +1,7 @@
 #include "mlidar/pipelines/odometry_job.hpp"
 
+#include <algorithm>
+
 #include <memory>
 
 #include <tbb/global_control.h>
@@ -84,6 +86,28 @@ std::vector<std::string> front_end_lines(const std::vector<slam::FrameResult>& r
   return lines;
 }
 
+/// Each auxiliary LiDAR's given extrinsic judged against the map over the frames' residuals (calib::ExtrinsicCheck;
+/// lost frames left out), the base first.
+std::vector<GivenExtrinsicDisagreement> check_given_extrinsics(const std::vector<slam::FrameResult>& results,
+                                                               const std::vector<slam::LidarSetup>& lidars, std::size_t base,
+                                                               const calib::ExtrinsicCheckConfig& config) {
+  std::vector<std::size_t> order{base};  // the check's LiDAR j is lidars[order[j]]
+  for (std::size_t i = 0; i < lidars.size(); ++i)
+    if (i != base) order.push_back(i);
+  calib::ExtrinsicCheck check(lidars.size(), config);
+  std::vector<bool> judged(lidars.size(), true);
+  judged[0] = false;  // the base defines the frame
+  std::vector<GivenExtrinsicDisagreement> found;
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    const std::vector<double>& residual = results[k].lidar_mean_residual_m;
+    if (results[k].lost() || residual.size() != lidars.size()) continue;
+    std::vector<double> ordered;
+    for (const std::size_t i : order) ordered.push_back(residual[i]);
+    for (const std::size_t j : check.update(ordered, judged)) found.push_back({lidars[order[j]].name, k, check.median_ratio(j).value_or(0.0)});
+  }
+  return found;
+}
+
 }  // namespace
 
 OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<void(int, int)>& progress) {
@@ -120,6 +144,11 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   summary.gaps = gaps.summary_lines();
   summary.front_end = front_end_lines(results, lidars, config.front_end.recover_rows);
   summary.base_failure = gaps.base_failure(job.max_base_gaps, source.reference_index());
+  const std::string base = source.dataset_info() ? source.dataset_info()->base : lidars.front().name;
+  const auto base_index = static_cast<std::size_t>(
+      std::find_if(lidars.begin(), lidars.end(), [&](const slam::LidarSetup& l) { return l.name == base; }) - lidars.begin());
+  if (base_index < lidars.size())
+    summary.disagreements = check_given_extrinsics(results, lidars, base_index, slam_config.extrinsic_check);
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
   write_map_ply(job.out / "map.ply", odometry);
@@ -129,6 +158,9 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   nlohmann::json metrics = odometry_metrics_json(results, lidars);
   add_pose_covariance_traces(metrics, covariances);
   metrics["skipped_scans"] = gaps.json();
+  metrics["extrinsic_check"] = nlohmann::json::array();
+  for (const GivenExtrinsicDisagreement& d : summary.disagreements)
+    metrics["extrinsic_check"].push_back({{"lidar", d.lidar}, {"disagreed_frame", d.frame}, {"residual_ratio", d.residual_ratio}});
   const std::string text = metrics.dump(2);
   io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << text << '\n'; });
   return summary;

@@ -44,6 +44,13 @@ struct OdometryJob {
   std::filesystem::path out;
 };
 
+/// A given extrinsic that disagreed with the map (calib::ExtrinsicCheck): the odometry used it as given.
+struct GivenExtrinsicDisagreement {
+  std::string lidar;
+  std::size_t frame = 0;        ///< the frame the median ratio crossed the limit
+  double residual_ratio = 0.0;  ///< that median of the LiDAR's residual over the base's
+};
+
 struct OdometryJobSummary {
   std::size_t frames = 0;
   std::size_t degenerate_frames = 0;
@@ -57,6 +64,9 @@ struct OdometryJobSummary {
   std::vector<std::string> front_end;        ///< per LiDAR without a model: rows recovered or voxel samples, in words
   std::optional<std::string> base_failure;   ///< the base LiDAR lacked too many frames (exit 1)
   Mat6 last_pose_covariance = Mat6::Zero();  ///< the last frame's, as pose_covariance.txt holds it
+  std::vector<GivenExtrinsicDisagreement> disagreements;
+  /// The result can be trusted (exit 0): no frame lost, the base not missing, no given extrinsic that disagreed.
+  bool trusted() const { return lost_frames == 0 && !base_failure && disagreements.empty(); }
 };
 
 /// UsageError for a bad combination of options; InputError for bad files.

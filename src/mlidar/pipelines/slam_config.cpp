@@ -150,6 +150,18 @@ std::vector<Field> shock_fields(SlamConfig& c) {
   };
 }
 
+std::vector<Field> extrinsic_check_fields(SlamConfig& c) {
+  return {
+      {"extrinsic_check", "frames", {1, 1e5}, "frames in the median residual ratio of a given extrinsic", &c.extrinsic_check.frames},
+      {"extrinsic_check",
+       "residual_ratio",
+       {0.0, 100.0},
+       "median ratio of a LiDAR's residual to the base's above which its given extrinsic disagrees with the map (0: no check)",
+       &c.extrinsic_check.residual_ratio},
+      {"extrinsic_check", "recalibrate", {}, "calibrate a disagreeing extrinsic online from it (else report only)", &c.recalibrate_disagreeing},
+  };
+}
+
 std::vector<Field> odometry_fields(SlamConfig& c) {
   slam::OdometryConfig& odo = c.odometry;
   return {
@@ -302,7 +314,7 @@ std::vector<Field> mapping_fields(SlamConfig& c) {
 std::vector<Field> fields(SlamConfig& c) {
   std::vector<Field> all;
   for (auto* section :
-       {&initialization_fields, &convergence_fields, &window_fields, &shock_fields, &odometry_fields, &selection_fields, &mapping_fields}) {
+       {&initialization_fields, &convergence_fields, &window_fields, &shock_fields, &extrinsic_check_fields, &odometry_fields, &selection_fields, &mapping_fields}) {
     const std::vector<Field> rows = section(c);
     all.insert(all.end(), rows.begin(), rows.end());
   }

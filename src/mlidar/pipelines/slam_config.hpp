@@ -13,6 +13,7 @@
 
 #include "mlidar/calib/convergence_monitor.hpp"
 #include "mlidar/calib/online_hand_eye.hpp"
+#include "mlidar/calib/extrinsic_check.hpp"
 #include "mlidar/calib/shock_detector.hpp"
 #include "mlidar/pipelines/slam_appearance_start.hpp"
 #include "mlidar/slam/odometry.hpp"
@@ -62,6 +63,10 @@ struct SlamConfig {
   /// Re-calibration trigger; a rise below 2x is not a shock: a sustained 1.45-1.76x rise of one LiDAR's residual
   /// ratio in part of the simulated room fired a false trigger (43 m protocol, room seed 6), Table 4.6's shock is 6x.
   calib::ShockDetectorConfig shock{.min_relative_jump = 1.0};
+  /// Given extrinsics (`--calibrate fixed`) judged against the map (calib/extrinsic_check.hpp).
+  calib::ExtrinsicCheckConfig extrinsic_check;
+  /// A given extrinsic that disagrees is calibrated online from it, as `--calibrate refine` does (else only reported).
+  bool recalibrate_disagreeing = true;
   slam::OdometryConfig odometry;  ///< front end and scan-to-map registration; odometry.uncertainty is `mapping:`
   MappingParams mapping;
 };

@@ -24,14 +24,22 @@ Frame trusted_frame(double stamp, const std::vector<std::optional<Scan>>& scans,
 
 }  // namespace
 
-SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source)
+SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source,
+                             const std::vector<std::optional<ExtrinsicDisagreement>>& disagreed)
     : config_(std::move(config)),
       source_(source),
       shock_(lidars.size(), config_.shock),
+      extrinsic_check_(lidars.size(), config_.extrinsic_check),
       history_(config_.start.appearance_after_frames + 1, static_cast<std::size_t>(std::max(config_.appearance.refine.frame_step, 1))) {
   if (lidars.empty()) throw std::invalid_argument("SlamEstimator: no LiDARs");
   tracks_.reserve(lidars.size());  // the tracks refer to config_, never moved after this
   for (std::size_t j = 0; j < lidars.size(); ++j) tracks_.emplace_back(std::move(lidars[j]), j == 0, source, config_);
+  for (std::size_t j = 1; j < disagreed.size() && j < tracks_.size(); ++j)
+    if (disagreed[j] && tracks_[j].extrinsic_given()) {
+      ExtrinsicDisagreement known = *disagreed[j];
+      known.from_first_frame = true;
+      tracks_[j].given_disagrees(known, true);
+    }
   odometry_ = std::make_unique<slam::Odometry>(config_.odometry, trusted_setups());
   if (config_.window.refine_odometry) pose_window_.emplace(config_);
 }
@@ -101,6 +109,38 @@ void SlamEstimator::detect_shocks(SlamFrame& out) {
   }
 }
 
+void SlamEstimator::check_given_extrinsics(SlamFrame& out) {
+  // The residuals detect_shocks recorded: the trusted odometry's at this frame.
+  std::vector<double> residual(tracks_.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<bool> given(tracks_.size(), false);
+  for (std::size_t j = 0; j < tracks_.size(); ++j) {
+    if (out.lidars[j].mean_residual_m > 0.0) residual[j] = out.lidars[j].mean_residual_m;
+    given[j] = j > 0 && tracks_[j].extrinsic_given();
+  }
+  std::vector<std::size_t> disagreeing = extrinsic_check_.update(residual, given);
+  for (std::size_t j = 1; j < tracks_.size(); ++j)
+    if (given[j]) out.lidars[j].residual_ratio = extrinsic_check_.median_ratio(j).value_or(-1.0);
+  // Nothing registered yet with two or more LiDARs: the residuals say nothing, and any given one may be the cause.
+  const bool lost_from_start =
+      config_.extrinsic_check.residual_ratio > 0.0 && lost_from_start_ == kLostFromStartFrames && trusted_.size() > 1;
+  if (lost_from_start) {
+    disagreeing.clear();
+    for (std::size_t j = 1; j < tracks_.size(); ++j)
+      if (given[j] && !tracks_[j].disagreement()) disagreeing.push_back(j);
+  }
+  for (const std::size_t j : disagreeing) {
+    out.lidars[j].extrinsic_disagrees = true;
+    const ExtrinsicDisagreement disagreement{.frame = frames_ - 1,
+                                             .residual_ratio = lost_from_start ? -1.0 : out.lidars[j].residual_ratio,
+                                             .frames_lost = lost_from_start,
+                                             .after_shock = shock_.lidar(j).triggers > 0};
+    tracks_[j].given_disagrees(disagreement, config_.recalibrate_disagreeing);
+    if (!config_.recalibrate_disagreeing) continue;
+    extrinsic_check_.reset(j);
+    trusted_changed_ = true;
+  }
+}
+
 SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<Scan>>& scans) {
   if (scans.size() != tracks_.size()) throw std::invalid_argument("SlamEstimator::process: one scan (or nullopt) per LiDAR expected");
   const std::size_t k = frames_++;
@@ -113,6 +153,10 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   odometry_->set_selection_paused(calibrating && !odometry_->config().registration.selection.while_calibrating);
   last_odometry_ = odometry_->process(trusted_frame(stamp, scans, trusted_));
   out.lost = last_odometry_.lost();
+  if (k > 0 && !registered_once_) {
+    registered_once_ = !out.lost;
+    lost_from_start_ = out.lost ? lost_from_start_ + 1 : 0;
+  }
   out.suspect = last_odometry_.suspect();
   out.T_world_base = last_odometry_.T_world_base;
   out.pose_covariance = pose_covariance_.add(last_odometry_, k == 0);
@@ -137,6 +181,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   step_tracks(frame, scans, out);
   start = Clock::now();
   detect_shocks(out);
+  check_given_extrinsics(out);
   out.seconds.shock = seconds_since(start);
   if (trusted_changed_) {
     odometry_->set_lidars(trusted_setups());  // from the next frame on; the map and world are kept

@@ -28,6 +28,7 @@
 #include <span>
 #include <vector>
 
+#include "mlidar/calib/extrinsic_check.hpp"
 #include "mlidar/calib/shock_detector.hpp"
 #include "mlidar/pipelines/slam_config.hpp"
 #include "mlidar/pipelines/slam_lidar_track.hpp"
@@ -40,10 +41,17 @@ namespace mlidar::pipelines {
 
 class SlamEstimator {
  public:
+  /// Frames lost in a row from the second on after which every given auxiliary extrinsic is judged to disagree
+  /// with the map (calib::ExtrinsicCheck sees no residuals then): Table 4.6's shock on `rv` loses every frame.
+  static constexpr std::size_t kLostFromStartFrames = 5;
+
   /// `lidars`: base first. Online, their extrinsics serve only as the up
   /// direction of each LiDAR's own odometry (their rotation; give identity
-  /// when unknown); the estimate never starts from them. Throws std::invalid_argument for no LiDARs.
-  SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source);
+  /// when unknown); the estimate never starts from them. `disagreed[j]` (empty: none): LiDAR j's given extrinsic
+  /// is known to disagree with the map (from an earlier run over the same frames): it is calibrated from it from
+  /// the first frame on. Throws std::invalid_argument for no LiDARs.
+  SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> lidars, ExtrinsicSource source,
+                const std::vector<std::optional<ExtrinsicDisagreement>>& disagreed = {});
   SlamEstimator(const SlamEstimator&) = delete;
   SlamEstimator& operator=(const SlamEstimator&) = delete;
 
@@ -67,11 +75,13 @@ class SlamEstimator {
   void keep_for_appearance(std::size_t k, double stamp, const std::vector<std::optional<Scan>>& scans);
   void step_tracks(const TrackFrame& frame, const std::vector<std::optional<Scan>>& scans, SlamFrame& out);
   void detect_shocks(SlamFrame& out);
+  void check_given_extrinsics(SlamFrame& out);
 
   SlamConfig config_;  ///< the tracks refer to it
   ExtrinsicSource source_;
   std::vector<LidarTrack> tracks_;
   calib::ShockDetector shock_;
+  calib::ExtrinsicCheck extrinsic_check_;
   std::unique_ptr<slam::Odometry> odometry_;  ///< over the trusted LiDARs
   std::vector<std::size_t> trusted_;          ///< indices in odometry_'s LiDAR order
   slam::FrameResult last_odometry_;
@@ -80,6 +90,8 @@ class SlamEstimator {
   AppearanceHistory history_;                  ///< the last appearance_after_frames + 1 frames while some LiDAR initializes
   bool trusted_changed_ = false;
   std::size_t frames_ = 0;
+  std::size_t lost_from_start_ = 0;  ///< frames lost in a row from the second on (0 once one was registered)
+  bool registered_once_ = false;
 };
 
 }  // namespace mlidar::pipelines

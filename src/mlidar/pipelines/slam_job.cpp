@@ -96,19 +96,30 @@ void write_extrinsics_file(const std::filesystem::path& path, const BaseFrame& f
 /// A report from the reference LiDAR's frame into the base frame.
 SlamLidarReport report_in_base(SlamLidarReport report, const BaseFrame& frame) {
   report.T_base_lidar = frame.extrinsic_to_base(report.T_base_lidar);
+  report.given_T_base_lidar = frame.extrinsic_to_base(report.given_T_base_lidar);
   if (report.covariance) report.covariance = frame.covariance_to_base(*report.covariance);
   return report;
 }
 
 /// The records of every frame, in order.
 struct SlamRun {
+  bool stopped_at_disagreement = false;  ///< a given extrinsic disagreed with the map at the last frame
   std::vector<SlamFrame> frames;
   std::vector<double> load_seconds;
   std::vector<slam::WindowPose> revisions;  ///< the window's final estimates of earlier frames, in the order given
 };
 
+/// A given extrinsic that should have been calibrated from the first frame: found at this frame to disagree with
+/// the map, calibrated from there (extrinsic_check.recalibrate), and not after an extrinsic shock of that LiDAR
+/// (its mounting moved during the run: it was right before).
+bool calibrate_from_the_start(const SlamEstimator& estimator, std::size_t j) {
+  const std::optional<ExtrinsicDisagreement>& found = estimator.track(j).disagreement();
+  return found && found->recalibrated && !found->after_shock && !found->from_first_frame;
+}
+
+/// With `stop_at_disagreement` the run ends at the first frame where calibrate_from_the_start holds for a LiDAR.
 SlamRun run_frames(const io::FrameSource& source, const std::vector<std::size_t>& order, SlamEstimator& estimator, FrameGaps& gaps,
-                   const std::function<void(int, int)>& progress) {
+                   bool stop_at_disagreement, const std::function<void(int, int)>& progress) {
   SlamRun run;
   for (std::size_t k = 0; k < source.frames(); ++k) {
     const auto start = std::chrono::steady_clock::now();
@@ -120,6 +131,10 @@ SlamRun run_frames(const io::FrameSource& source, const std::vector<std::size_t>
     run.frames.push_back(estimator.process(frame.stamp, scans));
     if (const auto& settled = run.frames.back().settled) run.revisions.push_back(*settled);
     if (progress) progress(static_cast<int>(k + 1), static_cast<int>(source.frames()));
+    const auto& lidars = run.frames.back().lidars;
+    for (std::size_t j = 0; j < lidars.size() && stop_at_disagreement; ++j)
+      run.stopped_at_disagreement = run.stopped_at_disagreement || (lidars[j].extrinsic_disagrees && calibrate_from_the_start(estimator, j));
+    if (run.stopped_at_disagreement) return run;
   }
   const std::vector<slam::WindowPose> unsettled = estimator.unsettled_poses();
   run.revisions.insert(run.revisions.end(), unsettled.begin(), unsettled.end());
@@ -175,6 +190,12 @@ bool SlamJobSummary::all_converged() const {
   return std::all_of(lidars.begin(), lidars.end(), [](const SlamLidarReport& l) { return l.role == LidarRole::trusted; });
 }
 
+bool SlamJobSummary::extrinsic_disagreed() const {
+  return std::any_of(lidars.begin(), lidars.end(), [](const SlamLidarReport& l) { return l.disagreement.has_value(); });
+}
+
+bool SlamJobSummary::trusted() const { return all_converged() && lost_frames == 0 && !base_failure && !extrinsic_disagreed(); }
+
 SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, int)>& progress) {
   if (job.threads < 0) throw UsageError("--threads must be >= 0");
   const SlamConfig config = job.config.empty() ? SlamConfig{} : read_slam_config(job.config);
@@ -186,10 +207,21 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
 
   const BaseFrame frame = base_frame(source);
   const std::optional<io::Extrinsics> given = given_extrinsics(job, source, frame);
-  SlamEstimator estimator(config, estimator_setups(source, order, frame, given, config), job.calibrate);
-  FrameGaps gaps(source);
-  const SlamRun run = run_frames(source, order, estimator, gaps, progress);
-  SlamJobSummary summary = summarize(run, estimator, order, gaps, job, frame);
+  // A given extrinsic found to disagree with the map (extrinsic_check.recalibrate) is calibrated from the first frame
+  // on in a run started again: the frames before the verdict used it as given (not after an extrinsic shock: that
+  // one is calibrated from the verdict on).
+  std::vector<std::optional<ExtrinsicDisagreement>> disagreed(order.size());
+  std::unique_ptr<SlamEstimator> estimator;
+  std::unique_ptr<FrameGaps> gaps;
+  SlamRun run;
+  do {
+    estimator = std::make_unique<SlamEstimator>(config, estimator_setups(source, order, frame, given, config), job.calibrate, disagreed);
+    gaps = std::make_unique<FrameGaps>(source);
+    run = run_frames(source, order, *estimator, *gaps, config.recalibrate_disagreeing, progress);
+    for (std::size_t j = 1; j < order.size(); ++j)
+      if (calibrate_from_the_start(*estimator, j)) disagreed[j] = estimator->track(j).disagreement();
+  } while (run.stopped_at_disagreement);
+  SlamJobSummary summary = summarize(run, *estimator, order, *gaps, job, frame);
   std::filesystem::create_directories(job.out);
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
@@ -197,10 +229,10 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
   io::write_pose_covariances(job.out / "pose_covariance.txt", covariances);
   if (!covariances.empty()) summary.last_pose_covariance = covariances.back().covariance;
   write_extrinsics_file(job.out / "extrinsics.yaml", frame, summary.lidars);
-  write_map_ply(job.out / "map.ply", map_in_base(map_cloud(estimator.trusted_odometry()), frame));
+  write_map_ply(job.out / "map.ply", map_in_base(map_cloud(estimator->trusted_odometry()), frame));
   nlohmann::json metrics = slam_metrics_json(run.frames, order, summary.lidars, run.load_seconds, to_string(job.calibrate));
   add_pose_covariance_traces(metrics, covariances);
-  metrics["skipped_scans"] = gaps.json();
+  metrics["skipped_scans"] = gaps->json();
   metrics["convergence"] = {{"lambda_calib", config.convergence.lambda_calib}, {"accepted_needed", config.convergence.accepted_needed}};
   const std::string text = metrics.dump(2);
   io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << text << '\n'; });

@@ -51,6 +51,10 @@ struct SlamJobSummary {
   std::optional<std::string> base_failure;   ///< the base LiDAR lacked too many frames (exit 1)
   Mat6 last_pose_covariance = Mat6::Zero();  ///< the last frame's, as pose_covariance.txt holds it
   bool all_converged() const;                ///< every LiDAR trusted at the end
+  bool extrinsic_disagreed() const;          ///< some given extrinsic disagreed with the map (calib::ExtrinsicCheck)
+  /// The result can be trusted (exit 0): every LiDAR converged, no frame lost, the base not missing, no given
+  /// extrinsic that disagreed with the map.
+  bool trusted() const;
 };
 
 /// UsageError for bad options; InputError for bad files (dataset, config).

@@ -103,6 +103,7 @@ LidarTrack::LidarTrack(slam::LidarSetup setup, bool is_base, ExtrinsicSource sou
   // The base defines the base frame; online, the given extrinsic serves as the own odometry's up only: the estimate
   // never starts from it.
   if (is_base || source == ExtrinsicSource::online) setup_.T_base_lidar = SE3::identity();
+  given_T_base_lidar_ = setup_.T_base_lidar;
 }
 
 std::variant<LidarTrack::Initializing, LidarTrack::Calibrating, LidarTrack::Trusted> LidarTrack::initial_state() {
@@ -179,6 +180,19 @@ void LidarTrack::restart_after_shock() {
   state_ = start_initializing(false);  // restarted at its next scan, with up from that scan's ground
 }
 
+bool LidarTrack::extrinsic_given() const {
+  const auto* trusted = std::get_if<Trusted>(&state_);
+  return trusted != nullptr && !trusted->covariance;
+}
+
+void LidarTrack::given_disagrees(ExtrinsicDisagreement disagreement, bool recalibrate) {
+  disagreement_ = disagreement;
+  disagreement_->recalibrated = recalibrate;
+  if (!recalibrate) return;
+  monitor_.restart(0);
+  state_ = Calibrating{};
+}
+
 SlamLidarReport LidarTrack::report(std::span<const SlamFrame> frames, std::size_t index) const {
   SlamLidarReport r;
   r.name = setup_.name;
@@ -208,6 +222,8 @@ SlamLidarReport LidarTrack::report(std::span<const SlamFrame> frames, std::size_
     if (l.shock) r.shock_frames.push_back(k);
     if (l.reinitialized) r.reinitialization_frames.push_back(k);
   }
+  r.disagreement = disagreement_;
+  r.given_T_base_lidar = given_T_base_lidar_;
   return r;
 }
 

@@ -10,6 +10,8 @@
 //   Calibrating  --its windows' residual stays above the base's, none
 //                  accepted (StartParams::reinitialize_*)-------------------> Initializing
 //   Trusted      --an extrinsic shock (online only; the estimator decides)-> Initializing
+//   Trusted      --a given extrinsic that disagrees with the map (fixed;
+//                  the estimator decides, calib::ExtrinsicCheck)-----------> Calibrating
 //
 // Initializing runs the LiDAR's own odometry (its up direction T_g_lidar from
 // the given extrinsic's rotation, or after a shock from its next scan's
@@ -84,6 +86,12 @@ class LidarTrack {
   /// Trusted -> Initializing after an extrinsic shock: hand-eye and Algorithm 1 start again; the own odometry
   /// restarts at the next scan with up from that scan's ground near the current extrinsic's.
   void restart_after_shock();
+  /// Its extrinsic as given, not estimated here (the base's, fixed extrinsics'): what calib::ExtrinsicCheck judges.
+  bool extrinsic_given() const;
+  /// Records that its given extrinsic disagreed with the map; with `recalibrate`, Trusted -> Calibrating from that
+  /// extrinsic (as `--calibrate refine` starts).
+  void given_disagrees(ExtrinsicDisagreement disagreement, bool recalibrate);
+  const std::optional<ExtrinsicDisagreement>& disagreement() const { return disagreement_; }
 
   /// The report after `frames` (this track's entries at `index` of each frame's lidars).
   SlamLidarReport report(std::span<const SlamFrame> frames, std::size_t index) const;
@@ -142,6 +150,8 @@ class LidarTrack {
   slam::LidarSetup setup_;  ///< T_base_lidar: the current extrinsic
   SE3 T_g_lidar_;           ///< the frame the own odometry runs in: the LiDAR's rotated so that z is up
   LidarRole initial_role_;
+  SE3 given_T_base_lidar_;  ///< the extrinsic it started with
+  std::optional<ExtrinsicDisagreement> disagreement_;
   calib::ConvergenceMonitor monitor_;  ///< Algorithm 1 for this LiDAR
   StartRecord start_;
   std::variant<Initializing, Calibrating, Trusted> state_;

@@ -1,5 +1,6 @@
 #include "mlidar/pipelines/slam_metrics.hpp"
 
+#include "mlidar/core/conversions.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 
 namespace mlidar::pipelines {
@@ -52,7 +53,24 @@ nlohmann::json lidar_frame_json(const SlamLidarFrame& l) {
           {"window_step_m", number_or_null(l.window_step_m)},
           {"window_step_deg", number_or_null(l.window_step_deg)},
           {"window_settled", l.window_settled},
-          {"reinitialized", l.reinitialized}};
+          {"reinitialized", l.reinitialized},
+          {"residual_ratio", number_or_null(l.residual_ratio)},
+          {"extrinsic_disagrees", l.extrinsic_disagrees}};
+}
+
+/// The given-extrinsic check's verdict (calib/extrinsic_check.hpp): null when it never disagreed.
+nlohmann::json extrinsic_check_json(const SlamLidarReport& l) {
+  if (!l.disagreement) return nullptr;
+  const SE3 T_given_current = l.given_T_base_lidar.inverse() * l.T_base_lidar;
+  return {{"disagreed_frame", l.disagreement->frame},
+          {"residual_ratio", number_or_null(l.disagreement->residual_ratio)},
+          {"frames_lost", l.disagreement->frames_lost},
+          {"recalibrated", l.disagreement->recalibrated},
+          {"from_first_frame", l.disagreement->from_first_frame},
+          {"after_shock", l.disagreement->after_shock},
+          {"given", pose_json(l.given_T_base_lidar)},
+          {"current_minus_given_m", T_given_current.translation().norm()},
+          {"current_minus_given_deg", rad_to_deg(Eigen::AngleAxisd(T_given_current.rotation()).angle())}};
 }
 
 nlohmann::json matrix_json_6(const Mat6& m) { return std::vector<double>(m.data(), m.data() + 36); }
@@ -132,7 +150,8 @@ nlohmann::json lidar_report_json(const SlamLidarReport& l) {
           {"shock_frames", l.shock_frames},
           {"reinitialization_frames", l.reinitialization_frames},
           {"missing_frames", l.missing_frames},
-          {"weak_directions", weak}};
+          {"weak_directions", weak},
+          {"extrinsic_check", extrinsic_check_json(l)}};
 }
 
 }  // namespace

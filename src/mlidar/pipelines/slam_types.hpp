@@ -53,6 +53,10 @@ struct SlamLidarFrame {
   double mean_residual_m = -1.0;              ///< against the map (-1: none)
   bool shock = false;                         ///< the re-calibration trigger fired
   bool reinitialized = false;                 ///< sent back to initialization (window residuals high, none accepted)
+  /// Its given extrinsic judged against the map (calib::ExtrinsicCheck): the median ratio of its residual to the
+  /// base's over the last frames (-1: not judged at this frame), and whether it crossed the limit here.
+  double residual_ratio = -1.0;
+  bool extrinsic_disagrees = false;
 };
 
 struct SlamFrame {
@@ -85,6 +89,19 @@ std::string_view to_string(TranslationStart start);  ///< "hand_eye", "zero", "a
 enum class AxisTranslationSource { none, ground_planes, set_to_zero };
 std::string_view to_string(AxisTranslationSource source);  ///< "ground planes", "set to 0"; "" for none
 
+/// A given extrinsic that disagreed with the map: at which frame, by which median ratio of the LiDAR's residual to
+/// the base's (calib::ExtrinsicCheck).
+struct ExtrinsicDisagreement {
+  std::size_t frame = 0;
+  double residual_ratio = 0.0;  ///< -1 when judged by lost frames
+  /// No frame after the first could be registered with it (SlamEstimator::kLostFromStartFrames lost in a row): with
+  /// two or more LiDARs given, which one is wrong is not known, so each is judged so.
+  bool frames_lost = false;
+  bool recalibrated = false;     ///< calibrated online from the given extrinsic since (else used as given)
+  bool from_first_frame = false;  ///< ... from the first frame on: found in an earlier run over the same frames
+  bool after_shock = false;       ///< its extrinsic shock trigger had fired before: the mounting moved during the run
+};
+
 /// Per-LiDAR history for the report.
 struct SlamLidarReport {
   std::string name;
@@ -103,6 +120,10 @@ struct SlamLidarReport {
   std::size_t missing_frames = 0;
   std::vector<calib::WeakDirection> weak;            ///< directions of the last window below lambda_calib
   std::vector<std::size_t> reinitialization_frames;  ///< frames where a calibrating LiDAR went back to initialization
+  /// Its given extrinsic found to disagree with the map (calib::ExtrinsicCheck), and that extrinsic (the current one
+  /// differs once it was calibrated from there).
+  std::optional<ExtrinsicDisagreement> disagreement;
+  SE3 given_T_base_lidar;
   /// Extrinsic directions the motion left unobservable at the last hand-eye start (planar motion), in words.
   std::vector<std::string> unobservable_from_motion;
   AxisTranslationSource axis_translation_source = AxisTranslationSource::none;  ///< planar motion only
