@@ -4,12 +4,14 @@
 // rows of real ring-less keyframes, and whole odometry over ten of them.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "mlidar/core/pose_uncertainty.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/sim/acquisition.hpp"
 #include "mlidar/sim/rig.hpp"
@@ -254,20 +256,43 @@ BENCHMARK(BM_RegisterSelected)
     ->Args({2, 50, 80})
     ->Unit(benchmark::kMillisecond);
 
-/// kFrames whole frames (front ends, registration, map update) with the first N LiDARs per iteration.
+/// kFrames whole frames (front ends, registration, map update) with the first N LiDARs per iteration; the second
+/// argument 1: uncertainty-aware mapping (issue 19's speed criterion: <= +15 % per frame on 4 LiDARs).
 void BM_OdometryFrame(benchmark::State& state) {
   const Sequence& data = sequence();
   const auto count = static_cast<std::size_t>(state.range(0));
   const std::vector<LidarSetup> lidars(data.lidars.begin(), data.lidars.begin() + static_cast<std::ptrdiff_t>(count));
   std::vector<Frame> frames = data.frames;
   for (auto& frame : frames) frame.scans.resize(count);
+  OdometryConfig config;
+  config.uncertainty.enabled = state.range(1) == 1;
   for (auto _ : state) {
-    Odometry odometry({}, lidars);
+    Odometry odometry(config, lidars);
     for (const Frame& frame : frames) benchmark::DoNotOptimize(odometry.process(frame).T_world_base);
   }
   state.SetItemsProcessed(state.iterations() * kFrames);  // items_per_second = frames per second
 }
-BENCHMARK(BM_OdometryFrame)->DenseRange(1, 4)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OdometryFrame)->ArgsProduct({{1, 2, 3, 4}, {0}})->Args({4, 1})->Unit(benchmark::kMillisecond);
+
+/// Eq 4.29 for 10k points of one LiDAR pose: the general H Theta H^T (arg 0) and the closed form per pose (arg 1).
+void BM_PointCovariances(benchmark::State& state) {
+  Mat6 covariance = Mat6::Identity() * 1e-4;
+  covariance.bottomRightCorner<3, 3>() *= 0.01;
+  const UncertainPose T_world_lidar{SE3::exp((Vec6() << 3.0, -1.0, 1.5, 0.1, -0.2, 0.8).finished()), covariance};
+  std::vector<Vec3> points;
+  for (int i = 0; i < 10000; ++i) points.emplace_back(20.0 * std::cos(0.01 * i), 20.0 * std::sin(0.01 * i), 0.001 * i - 2.0);
+  const BeamPointCovariance closed_form(T_world_lidar, 0.03, 0.003);
+  for (auto _ : state) {
+    for (const Vec3& p : points) {
+      if (state.range(0) == 0)
+        benchmark::DoNotOptimize(point_covariance(T_world_lidar, p, lidar_point_noise(p, 0.03, 0.003)));
+      else
+        benchmark::DoNotOptimize(closed_form(p));
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(points.size()));
+}
+BENCHMARK(BM_PointCovariances)->Arg(0)->Arg(1);
 
 /// BALM keyframes 30..39 (0.5 s apart, taken while moving: voxel samples), read once; empty without the shared data.
 const std::vector<Frame>& balm_keyframes() {

@@ -160,6 +160,22 @@ TEST(PointCovariance, WithCertainPoseIsRotatedSensorNoise) {
   EXPECT_LT((point_covariance(T_world_lidar, p_lidar, Z) - R * Z * R.transpose()).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// The closed form for many points of one pose is the general H Theta H^T with Z = lidar_point_noise.
+TEST(PointCovariance, TheClosedFormForOnePoseIsTheGeneralOne) {
+  const UncertainPose T_world_lidar{pose_from(5.0, -2.0, 1.5, 0.3, -0.8, 0.5),
+                                    correlated_covariance(sigmas_of(0.05, 0.08, 0.04, 0.01, 0.02, 0.015), 5)};
+  const BeamPointCovariance beam(T_world_lidar, 0.03, 0.003);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> coordinate(-60.0, 60.0);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p_lidar(coordinate(rng), coordinate(rng), coordinate(rng));
+    const Mat3 general = point_covariance(T_world_lidar, p_lidar, lidar_point_noise(p_lidar, 0.03, 0.003));
+    EXPECT_LT((beam(p_lidar) - general).cwiseAbs().maxCoeff(), 1e-12 * general.cwiseAbs().maxCoeff()) << p_lidar.transpose();
+  }
+  const Mat3 at_origin = point_covariance(T_world_lidar, Vec3::Zero(), lidar_point_noise(Vec3::Zero(), 0.03, 0.003));
+  EXPECT_LT((beam(Vec3::Zero()) - at_origin).cwiseAbs().maxCoeff(), 1e-15);
+}
+
 TEST(LidarPointNoise, EigenvaluesAreRangeAlongBeamAndLateralAcross) {
   const Vec3 p_lidar(30.0, -40.0, 0.0);  // r = 50 m
   const double range_sigma = 0.02;

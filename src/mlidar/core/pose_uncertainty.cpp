@@ -104,4 +104,27 @@ Mat3 point_covariance(const UncertainPose& T_world_lidar, const Vec3& p_lidar, c
   return from_pose + from_point;
 }
 
+BeamPointCovariance::BeamPointCovariance(const UncertainPose& T_world_lidar, double range_sigma_m, double angular_sigma_rad)
+    : T_world_lidar_(T_world_lidar.T),
+      R_(T_world_lidar.T.rotation_matrix()),
+      sigma_tt_(T_world_lidar.covariance.topLeftCorner<3, 3>()),
+      sigma_tr_(T_world_lidar.covariance.topRightCorner<3, 3>()),
+      sigma_rr_(T_world_lidar.covariance.bottomRightCorner<3, 3>()),
+      range_variance_(range_sigma_m * range_sigma_m),
+      angular_variance_(angular_sigma_rad * angular_sigma_rad) {}
+
+Mat3 BeamPointCovariance::operator()(const Vec3& p_lidar) const {
+  const Vec3 rotated = R_ * p_lidar;
+  const Vec3 p_world = rotated + T_world_lidar_.translation();
+  const Mat3 P = -hat(p_world);
+  const Mat3 cross = sigma_tr_ * P.transpose();
+  Mat3 out = sigma_tt_ + cross + cross.transpose() + P * sigma_rr_ * P.transpose();  // eq 4.29, pose part
+  const double range_squared = p_lidar.squaredNorm();
+  if (!(range_squared > 0.0)) return out + range_variance_ * Mat3::Identity();  // no bearing at the origin
+  const double lateral_variance = range_squared * angular_variance_;
+  out += (range_variance_ - lateral_variance) / range_squared * (rotated * rotated.transpose());  // b b^T = R p p^T R^T / r^2
+  out.diagonal().array() += lateral_variance;
+  return out;
+}
+
 }  // namespace mlidar

@@ -37,4 +37,22 @@ Mat3 lidar_point_noise(const Vec3& p_lidar, double range_sigma_m, double angular
 /// H = [I, -(T p)^, R].
 Mat3 point_covariance(const UncertainPose& T_world_lidar, const Vec3& p_lidar, const Mat3& Z);
 
+/// point_covariance(T_world_lidar, p, lidar_point_noise(p, range_sigma_m, angular_sigma_rad)) for many points of one
+/// LiDAR pose, in closed form: R Z R^T = s_l^2 I + (s_r^2 - s_l^2) b b^T with b the world bearing R p / |p| and
+/// s_l = |p| angular_sigma_rad, and J Sigma J^T for J = [I, P], P = -(T p)^, as Sigma_tt + Sigma_tr P^T + P Sigma_rt
+/// + P Sigma_rr P^T (the rotation matrix and the covariance blocks taken once per pose).
+class BeamPointCovariance {
+ public:
+  BeamPointCovariance(const UncertainPose& T_world_lidar, double range_sigma_m, double angular_sigma_rad);
+  /// The covariance (m^2, world frame) of the point p_lidar (m, LiDAR frame).
+  Mat3 operator()(const Vec3& p_lidar) const;
+
+ private:
+  SE3 T_world_lidar_;
+  Mat3 R_;
+  Mat3 sigma_tt_, sigma_tr_, sigma_rr_;
+  double range_variance_;
+  double angular_variance_;
+};
+
 }  // namespace mlidar

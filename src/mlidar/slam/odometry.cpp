@@ -198,11 +198,10 @@ namespace {
 void append_covariant(const UncertainPose& T_world_lidar, const SE3& T_lidar_base, const SE3& T_world_base,
                       std::span<const Eigen::Vector3f> points_base, double range_sigma_m, double angular_sigma_rad, std::uint8_t source,
                       std::vector<CovariantPoint>& out) {
+  const BeamPointCovariance covariance_of(T_world_lidar, range_sigma_m, angular_sigma_rad);
   for (const Eigen::Vector3f& p : points_base) {
     const Vec3 p_base = p.cast<double>();
-    const Vec3 p_lidar = T_lidar_base * p_base;
-    const Mat3 Z = lidar_point_noise(p_lidar, range_sigma_m, angular_sigma_rad);
-    out.push_back({(T_world_base * p_base).cast<float>(), PointCovariance::from(point_covariance(T_world_lidar, p_lidar, Z)), source});
+    out.push_back({(T_world_base * p_base).cast<float>(), PointCovariance::from(covariance_of(T_lidar_base * p_base)), source});
   }
 }
 

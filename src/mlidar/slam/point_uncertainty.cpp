@@ -31,13 +31,10 @@ double PointCovariance::along(const Vec3& n) const {
 std::vector<PointCovariance> feature_covariances(std::span<const Eigen::Vector3f> points_base, const UncertainPose& T_base_lidar,
                                                  double range_sigma_m, double angular_sigma_rad) {
   const SE3 T_lidar_base = T_base_lidar.T.inverse();
+  const BeamPointCovariance covariance_of(T_base_lidar, range_sigma_m, angular_sigma_rad);  // eq 4.29
   std::vector<PointCovariance> out;
   out.reserve(points_base.size());
-  for (const Eigen::Vector3f& p : points_base) {
-    const Vec3 p_lidar = T_lidar_base * Vec3(p.cast<double>());
-    const Mat3 Z = lidar_point_noise(p_lidar, range_sigma_m, angular_sigma_rad);
-    out.push_back(PointCovariance::from(point_covariance(T_base_lidar, p_lidar, Z)));  // eq 4.29
-  }
+  for (const Eigen::Vector3f& p : points_base) out.push_back(PointCovariance::from(covariance_of(T_lidar_base * Vec3(p.cast<double>()))));
   return out;
 }
 
@@ -59,7 +56,9 @@ std::vector<CovariantPoint> covariance_voxel_filter(std::span<const CovariantPoi
   if (!(cube_m > 0.0)) throw std::invalid_argument("covariance_voxel_filter: cube edge must be > 0");
   const double inv = 1.0 / cube_m;
   tsl::robin_map<VoxelKey, std::size_t, VoxelKeyHash> index;
+  index.reserve(points.size());  // no rehash on the way
   std::vector<Cube> cubes;
+  cubes.reserve(points.size());
   for (const CovariantPoint& p : points) {
     const auto [it, added] = index.try_emplace(voxel_key(p.point, inv), cubes.size());
     if (added) cubes.emplace_back();
