@@ -1,5 +1,6 @@
 // `mlidar odometry`: multi-LiDAR scan-to-map odometry over a dataset or a folder of clouds.
 #include <cmath>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -15,6 +16,13 @@
 
 namespace mlidar::cli {
 namespace {
+
+std::string one_decimal(double value) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << value;
+  return text.str();
+}
+
 
 struct OdometryOptions {
   std::string dataset;
@@ -77,9 +85,13 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
   if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';
   for (const pipelines::GivenExtrinsicDisagreement& d : summary.disagreements)
-    std::cerr << "warning: " << d.lidar << ": the given extrinsic disagrees with the map (at frame " << d.frame << " its residual was "
-              << std::lround(d.residual_ratio * 10.0) / 10.0 << "x the base's, the median of the last extrinsic_check.frames frames; "
-              << "right extrinsics stay near 1): the trajectory and map may be wrong; check it, or calibrate it with "
+    std::cerr << "warning: " << d.lidar << ": the given extrinsic disagrees with the map ("
+              << (d.map_ratio > 0.0 ? "its points in the final map lay " + one_decimal(d.map_ratio) +
+                                          "x farther from the other LiDARs' surfaces than from its own"
+                                    : "at frame " + std::to_string(d.frame) + " its residual was " +
+                                          one_decimal(d.residual_ratio) +
+                                          "x the base's, the median of the last extrinsic_check.frames frames")
+              << "; right extrinsics stay near 1): the trajectory and map may be wrong; check it, or calibrate it with "
               << "`mlidar slam --calibrate refine`\n";
   return summary.trusted() ? 0 : 1;
 }

@@ -72,6 +72,9 @@ std::string disagreement_warning(const pipelines::SlamLidarReport& lidar) {
   if (d.frames_lost)
     text << "(no frame after the first could be registered with the given extrinsics, " << pipelines::SlamEstimator::kLostFromStartFrames
          << " lost in a row: any of them may be wrong); ";
+  else if (d.map_ratio > 0.0)
+    text << "(at frame " << d.frame << " its points in the map lay " << d.map_ratio
+         << "x farther from the other LiDARs' surfaces than from its own; right extrinsics stay near 1); ";
   else
     text << "(at frame " << d.frame << " its residual was " << d.residual_ratio
          << "x the base's, the median of the last extrinsic_check.frames frames; right extrinsics stay near 1); ";

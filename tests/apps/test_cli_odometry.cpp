@@ -309,6 +309,22 @@ TEST(CliOdometry, AGivenExtrinsicThatDisagreesWithTheMapIsReported) {
   EXPECT_EQ(check[0]["lidar"], "right");
   EXPECT_EQ(check[0]["disagreed_frame"].get<int>(), 5);  // frames 1-5 give the first median of 5 (frame 0 registers nothing)
   EXPECT_GT(check[0]["residual_ratio"].get<double>(), 2.0);
+
+  // 0.1 m along each axis alone: the residual stays near the base's, the final map's points of the right LiDAR lie
+  // far off the left's planes (the map test).
+  io::Extrinsics shifted = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
+  for (auto& lidar : shifted.lidars)
+    if (lidar.name == "right") lidar.T_base_lidar = SE3(lidar.T_base_lidar.rotation(), lidar.T_base_lidar.translation() + Vec3(0.1, 0.1, 0.1));
+  io::write_extrinsics(dir / "shifted.yaml", shifted);
+  const fs::path shifted_run = dir / "shifted";
+  const CliResult by_map =
+      run_cli(common + " --extrinsics " + quoted((dir / "shifted.yaml").string()) + " --out " + quoted(shifted_run.string()));
+  EXPECT_EQ(by_map.exit_code, 1) << by_map.output;
+  const auto map_check = nlohmann::json::parse(std::ifstream(shifted_run / "metrics.json"))["extrinsic_check"];
+  ASSERT_EQ(map_check.size(), 1u) << map_check;
+  EXPECT_TRUE(map_check[0]["residual_ratio"].is_null()) << map_check;
+  EXPECT_GT(map_check[0]["map_ratio"].get<double>(), 3.0);
+  EXPECT_EQ(map_check[0]["disagreed_frame"].get<int>(), kCheckFrames - 1);
 }
 
 // Real keyframes are rarely evenly spaced: --times gives each cloud its stamp

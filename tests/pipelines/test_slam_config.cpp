@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 71u);
+  EXPECT_EQ(slam_config_keys().size(), 73u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -126,7 +126,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  history: 80\n  min_history: 30\n  threshold_mads: 3.5\n  min_relative_jump: 0.4\n  consecutive: 7\n"
       "  relative_to_others: false\n"
       "extrinsic_check:\n"
-      "  frames: 15\n  residual_ratio: 2.5\n  recalibrate: false\n"
+      "  frames: 15\n  residual_ratio: 2.5\n  map_first_frames: 40\n  map_ratio: 4\n  recalibrate: false\n"
       "odometry:\n"
       "  plane_voxel_m: 0.7\n  edge_voxel_m: 0.3\n  local_map_radius_m: 80\n  max_iterations: 12\n  refine_deskew: true\n"
       "  deskew_in_registration: false\n  plane_neighbors_max: 8\n  voxel_plane_neighbors_max: 6\n  plane_extra_radius_m: 0.3\n"
@@ -182,6 +182,8 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_FALSE(c.shock.relative_to_others);
   EXPECT_EQ(c.extrinsic_check.frames, 15u);
   EXPECT_EQ(c.extrinsic_check.residual_ratio, 2.5);
+  EXPECT_EQ(c.extrinsic_check.map_first_frames, 40u);
+  EXPECT_EQ(c.extrinsic_check.map_ratio, 4.0);
   EXPECT_FALSE(c.recalibrate_disagreeing);
   EXPECT_EQ(c.odometry.plane_voxel_m, 0.7);
   EXPECT_EQ(c.odometry.edge_voxel_m, 0.3);

@@ -23,6 +23,11 @@ namespace mlidar::calib {
 struct ExtrinsicCheckConfig {
   std::size_t frames = 20;      ///< ratios in the median (a decision needs this many)
   double residual_ratio = 2.0;  ///< median ratio to the base's residual above which an extrinsic disagrees (0: no check at all)
+  /// The map test (slam/map_consistency.hpp) after this many frames and again at twice as many each time (30, 60,
+  /// 120, ...; 0: never; the odometry job: on its final map): a LiDAR's points map_ratio times farther from the other
+  /// LiDARs' planes than from its own disagree. Doubling keeps its cost (about 50 ms for 4 LiDARs) off long runs.
+  std::size_t map_first_frames = 30;
+  double map_ratio = 3.0;
 };
 
 class ExtrinsicCheck {

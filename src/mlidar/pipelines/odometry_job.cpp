@@ -14,6 +14,7 @@
 #include "mlidar/pipelines/given_extrinsics.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/pipelines/slam_config.hpp"
+#include "mlidar/slam/map_consistency.hpp"
 #include "mlidar/slam/odometry.hpp"
 
 namespace mlidar::pipelines {
@@ -88,6 +89,9 @@ std::vector<std::string> front_end_lines(const std::vector<slam::FrameResult>& r
 
 /// Each auxiliary LiDAR's given extrinsic judged against the map over the frames' residuals (calib::ExtrinsicCheck;
 /// lost frames left out), the base first.
+/// Planar neighbourhoods the map test needs of a LiDAR, of its own and of the others', to judge it.
+constexpr std::size_t kMapTestPlanes = 100;
+
 std::vector<GivenExtrinsicDisagreement> check_given_extrinsics(const std::vector<slam::FrameResult>& results,
                                                                const std::vector<slam::LidarSetup>& lidars, std::size_t base,
                                                                const calib::ExtrinsicCheckConfig& config) {
@@ -103,9 +107,27 @@ std::vector<GivenExtrinsicDisagreement> check_given_extrinsics(const std::vector
     if (results[k].lost() || residual.size() != lidars.size()) continue;
     std::vector<double> ordered;
     for (const std::size_t i : order) ordered.push_back(residual[i]);
-    for (const std::size_t j : check.update(ordered, judged)) found.push_back({lidars[order[j]].name, k, check.median_ratio(j).value_or(0.0)});
+    for (const std::size_t j : check.update(ordered, judged))
+      found.push_back({lidars[order[j]].name, k, check.median_ratio(j).value_or(0.0), -1.0});
   }
   return found;
+}
+
+/// The map test (slam/map_consistency.hpp) on the final map: each auxiliary LiDAR not judged yet whose points lie
+/// map_ratio times farther from the others' planes than from its own (the map's sources are the odometry's order).
+void add_map_disagreements(const slam::Odometry& odometry, const std::vector<slam::LidarSetup>& lidars, std::size_t base,
+                           const calib::ExtrinsicCheckConfig& config, std::size_t frames, std::vector<GivenExtrinsicDisagreement>& found) {
+  if (config.map_first_frames == 0 || frames == 0) return;
+  const std::vector<slam::SourceConsistency> consistency = slam::map_consistency(odometry.plane_map(), lidars.size());
+  for (std::size_t i = 0; i < consistency.size(); ++i) {
+    const slam::SourceConsistency& c = consistency[i];
+    const std::string& name = lidars.at(c.source).name;
+    const bool judged = std::any_of(found.begin(), found.end(), [&](const GivenExtrinsicDisagreement& d) { return d.lidar == name; });
+    const double ratio = slam::consistency_ratio(consistency, i);
+    if (c.source == base || judged || c.self_planes < kMapTestPlanes || c.cross_planes < kMapTestPlanes || !(ratio > config.map_ratio))
+      continue;
+    found.push_back({name, frames - 1, -1.0, ratio});
+  }
 }
 
 }  // namespace
@@ -147,8 +169,10 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   const std::string base = source.dataset_info() ? source.dataset_info()->base : lidars.front().name;
   const auto base_index = static_cast<std::size_t>(
       std::find_if(lidars.begin(), lidars.end(), [&](const slam::LidarSetup& l) { return l.name == base; }) - lidars.begin());
-  if (base_index < lidars.size())
+  if (base_index < lidars.size() && slam_config.extrinsic_check.residual_ratio > 0.0) {
     summary.disagreements = check_given_extrinsics(results, lidars, base_index, slam_config.extrinsic_check);
+    add_map_disagreements(odometry, lidars, base_index, slam_config.extrinsic_check, results.size(), summary.disagreements);
+  }
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
   write_map_ply(job.out / "map.ply", odometry);
@@ -160,7 +184,10 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   metrics["skipped_scans"] = gaps.json();
   metrics["extrinsic_check"] = nlohmann::json::array();
   for (const GivenExtrinsicDisagreement& d : summary.disagreements)
-    metrics["extrinsic_check"].push_back({{"lidar", d.lidar}, {"disagreed_frame", d.frame}, {"residual_ratio", d.residual_ratio}});
+    metrics["extrinsic_check"].push_back({{"lidar", d.lidar},
+                                          {"disagreed_frame", d.frame},
+                                          {"residual_ratio", d.residual_ratio > 0.0 ? nlohmann::json(d.residual_ratio) : nlohmann::json()},
+                                          {"map_ratio", d.map_ratio > 0.0 ? nlohmann::json(d.map_ratio) : nlohmann::json()}});
   const std::string text = metrics.dump(2);
   io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << text << '\n'; });
   return summary;

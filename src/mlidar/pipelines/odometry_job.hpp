@@ -47,8 +47,9 @@ struct OdometryJob {
 /// A given extrinsic that disagreed with the map (calib::ExtrinsicCheck): the odometry used it as given.
 struct GivenExtrinsicDisagreement {
   std::string lidar;
-  std::size_t frame = 0;        ///< the frame the median ratio crossed the limit
-  double residual_ratio = 0.0;  ///< that median of the LiDAR's residual over the base's
+  std::size_t frame = 0;        ///< the frame the median ratio crossed the limit (the last frame: the map test)
+  double residual_ratio = 0.0;  ///< that median of the LiDAR's residual over the base's (-1: judged by the map test)
+  double map_ratio = -1.0;      ///< the map test's ratio on the final map (slam/map_consistency.hpp; -1: not judged by it)
 };
 
 struct OdometryJobSummary {

@@ -158,6 +158,17 @@ std::vector<Field> extrinsic_check_fields(SlamConfig& c) {
        {0.0, 100.0},
        "median ratio of a LiDAR's residual to the base's above which its given extrinsic disagrees with the map (0: no check)",
        &c.extrinsic_check.residual_ratio},
+      {"extrinsic_check",
+       "map_first_frames",
+       {0, 1e5},
+       "frames before the first map test of the given extrinsics (each LiDAR's points against the others' planes), "
+       "again at twice as many each time (0: never)",
+       &c.extrinsic_check.map_first_frames},
+      {"extrinsic_check",
+       "map_ratio",
+       {1.0, 1000.0},
+       "a LiDAR's points this many times farther from the others' planes than from its own disagree",
+       &c.extrinsic_check.map_ratio},
       {"extrinsic_check", "recalibrate", {}, "calibrate a disagreeing extrinsic online from it (else report only)", &c.recalibrate_disagreeing},
   };
 }

@@ -1,10 +1,13 @@
 #include "mlidar/pipelines/slam_estimator.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "mlidar/slam/map_consistency.hpp"
 
 namespace mlidar::pipelines {
 namespace {
@@ -118,6 +121,8 @@ void SlamEstimator::check_given_extrinsics(SlamFrame& out) {
     given[j] = j > 0 && tracks_[j].extrinsic_given();
   }
   std::vector<std::size_t> disagreeing = extrinsic_check_.update(residual, given);
+  for (const std::size_t j : map_disagreements(given, out))
+    if (!tracks_[j].disagreement() && std::find(disagreeing.begin(), disagreeing.end(), j) == disagreeing.end()) disagreeing.push_back(j);
   for (std::size_t j = 1; j < tracks_.size(); ++j)
     if (given[j]) out.lidars[j].residual_ratio = extrinsic_check_.median_ratio(j).value_or(-1.0);
   // Nothing registered yet with two or more LiDARs: the residuals say nothing, and any given one may be the cause.
@@ -130,8 +135,10 @@ void SlamEstimator::check_given_extrinsics(SlamFrame& out) {
   }
   for (const std::size_t j : disagreeing) {
     out.lidars[j].extrinsic_disagrees = true;
+    const bool by_map = out.lidars[j].map_ratio > config_.extrinsic_check.map_ratio;
     const ExtrinsicDisagreement disagreement{.frame = frames_ - 1,
-                                             .residual_ratio = lost_from_start ? -1.0 : out.lidars[j].residual_ratio,
+                                             .residual_ratio = lost_from_start || by_map ? -1.0 : out.lidars[j].residual_ratio,
+                                             .map_ratio = by_map ? out.lidars[j].map_ratio : -1.0,
                                              .frames_lost = lost_from_start,
                                              .after_shock = shock_.lidar(j).triggers > 0};
     tracks_[j].given_disagrees(disagreement, config_.recalibrate_disagreeing);
@@ -139,6 +146,25 @@ void SlamEstimator::check_given_extrinsics(SlamFrame& out) {
     extrinsic_check_.reset(j);
     trusted_changed_ = true;
   }
+}
+
+std::vector<std::size_t> SlamEstimator::map_disagreements(const std::vector<bool>& given, SlamFrame& out) const {
+  const std::size_t first = config_.extrinsic_check.map_first_frames;
+  std::vector<std::size_t> found;
+  const bool due = first > 0 && frames_ % first == 0 && std::has_single_bit(frames_ / first);  // first * 2^n frames
+  if (!due || config_.extrinsic_check.residual_ratio == 0.0 || trusted_set_changed_ ||
+      std::find(given.begin(), given.end(), true) == given.end())
+    return found;
+  // The map's sources are the trusted odometry's LiDAR indices: trusted_[i] is LiDAR i's track.
+  const std::vector<slam::SourceConsistency> consistency = slam::map_consistency(odometry_->plane_map(), trusted_.size());
+  for (std::size_t i = 0; i < consistency.size(); ++i) {
+    const slam::SourceConsistency& c = consistency[i];
+    const std::size_t j = trusted_.at(c.source);
+    if (!given[j] || c.self_planes < kMapTestPlanes || c.cross_planes < kMapTestPlanes) continue;
+    out.lidars[j].map_ratio = slam::consistency_ratio(consistency, i);
+    if (out.lidars[j].map_ratio > config_.extrinsic_check.map_ratio) found.push_back(j);
+  }
+  return found;
 }
 
 SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<Scan>>& scans) {
@@ -184,6 +210,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   check_given_extrinsics(out);
   out.seconds.shock = seconds_since(start);
   if (trusted_changed_) {
+    trusted_set_changed_ = true;
     odometry_->set_lidars(trusted_setups());  // from the next frame on; the map and world are kept
     out.trusted_changed = true;
   }

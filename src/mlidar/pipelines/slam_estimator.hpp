@@ -44,6 +44,8 @@ class SlamEstimator {
   /// Frames lost in a row from the second on after which every given auxiliary extrinsic is judged to disagree
   /// with the map (calib::ExtrinsicCheck sees no residuals then): Table 4.6's shock on `rv` loses every frame.
   static constexpr std::size_t kLostFromStartFrames = 5;
+  /// Planar neighbourhoods the map test needs of a LiDAR, of its own and of the others', to judge it.
+  static constexpr std::size_t kMapTestPlanes = 100;
 
   /// `lidars`: base first. Online, their extrinsics serve only as the up
   /// direction of each LiDAR's own odometry (their rotation; give identity
@@ -76,6 +78,8 @@ class SlamEstimator {
   void step_tracks(const TrackFrame& frame, const std::vector<std::optional<Scan>>& scans, SlamFrame& out);
   void detect_shocks(SlamFrame& out);
   void check_given_extrinsics(SlamFrame& out);
+  /// The map test (slam/map_consistency.hpp) of the given auxiliary extrinsics: the LiDARs that disagree.
+  std::vector<std::size_t> map_disagreements(const std::vector<bool>& given, SlamFrame& out) const;
 
   SlamConfig config_;  ///< the tracks refer to it
   ExtrinsicSource source_;
@@ -92,6 +96,7 @@ class SlamEstimator {
   std::size_t frames_ = 0;
   std::size_t lost_from_start_ = 0;  ///< frames lost in a row from the second on (0 once one was registered)
   bool registered_once_ = false;
+  bool trusted_set_changed_ = false;  ///< ever: the map's sources then no longer follow one LiDAR order
 };
 
 }  // namespace mlidar::pipelines

@@ -55,6 +55,7 @@ nlohmann::json lidar_frame_json(const SlamLidarFrame& l) {
           {"window_settled", l.window_settled},
           {"reinitialized", l.reinitialized},
           {"residual_ratio", number_or_null(l.residual_ratio)},
+          {"map_ratio", number_or_null(l.map_ratio)},
           {"extrinsic_disagrees", l.extrinsic_disagrees}};
 }
 
@@ -64,6 +65,7 @@ nlohmann::json extrinsic_check_json(const SlamLidarReport& l) {
   const SE3 T_given_current = l.given_T_base_lidar.inverse() * l.T_base_lidar;
   return {{"disagreed_frame", l.disagreement->frame},
           {"residual_ratio", number_or_null(l.disagreement->residual_ratio)},
+          {"map_ratio", number_or_null(l.disagreement->map_ratio)},
           {"frames_lost", l.disagreement->frames_lost},
           {"recalibrated", l.disagreement->recalibrated},
           {"from_first_frame", l.disagreement->from_first_frame},

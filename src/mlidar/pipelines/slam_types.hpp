@@ -56,6 +56,9 @@ struct SlamLidarFrame {
   /// Its given extrinsic judged against the map (calib::ExtrinsicCheck): the median ratio of its residual to the
   /// base's over the last frames (-1: not judged at this frame), and whether it crossed the limit here.
   double residual_ratio = -1.0;
+  /// The map test at this frame (slam/map_consistency.hpp): its points' median distance to the other LiDARs' planes
+  /// over that to its own (-1: not run at this frame).
+  double map_ratio = -1.0;
   bool extrinsic_disagrees = false;
 };
 
@@ -93,7 +96,8 @@ std::string_view to_string(AxisTranslationSource source);  ///< "ground planes",
 /// the base's (calib::ExtrinsicCheck).
 struct ExtrinsicDisagreement {
   std::size_t frame = 0;
-  double residual_ratio = 0.0;  ///< -1 when judged by lost frames
+  double residual_ratio = 0.0;  ///< -1 when judged by lost frames or by the map
+  double map_ratio = -1.0;      ///< the map test's ratio when it judged (slam/map_consistency.hpp), else -1
   /// No frame after the first could be registered with it (SlamEstimator::kLostFromStartFrames lost in a row): with
   /// two or more LiDARs given, which one is wrong is not known, so each is judged so.
   bool frames_lost = false;

@@ -38,8 +38,11 @@ void slam_verdicts(const RunData& run, std::vector<Verdict>& out) {
       const nlohmann::json check = lidar.value("extrinsic_check", nlohmann::json());
       if (check.is_object())
         out.push_back({"bad", name + ": the given extrinsic disagrees with the map (" +
-                                  (check.value("frames_lost", false)
-                                       ? "no frame could be registered with the given extrinsics; "
+                                  (check.value("frames_lost", false) ? "no frame could be registered with the given extrinsics; "
+                                   : number_of(check.value("map_ratio", nlohmann::json())) > 0.0
+                                       ? "at frame " + frame_text(check.value("disagreed_frame", nlohmann::json())) +
+                                             " its points lay " + fixed(number_of(check["map_ratio"]), 1) +
+                                             "x farther from the other LiDARs' surfaces than from its own); "
                                        : "from frame " + frame_text(check.value("disagreed_frame", nlohmann::json())) + " its residual was " +
                                              fixed(number_of(check.value("residual_ratio", nlohmann::json())), 1) + "x the base's); ") +
                                   (check.value("recalibrated", false) ? "calibrated online from it: see extrinsics.yaml and fix the input"
@@ -73,10 +76,13 @@ void frame_verdicts(const nlohmann::json& metrics, std::vector<Verdict>& out) {
     out.push_back({"bad", std::to_string(count("lost_frames")) + " frame(s) could not be registered (lost): their poses are predictions"});
   if (metrics.contains("extrinsic_check") && metrics["extrinsic_check"].is_array())  // odometry's (slam's: per LiDAR)
     for (const auto& d : metrics["extrinsic_check"])
-      out.push_back({"bad", d.value("lidar", std::string("?")) + ": the given extrinsic disagrees with the map (from frame " +
-                                frame_text(d.value("disagreed_frame", nlohmann::json())) + " its residual was " +
-                                fixed(number_of(d.value("residual_ratio", nlohmann::json())), 1) +
-                                "x the base's): the trajectory and map may be wrong; calibrate it with `mlidar slam --calibrate refine`"});
+      out.push_back({"bad", d.value("lidar", std::string("?")) + ": the given extrinsic disagrees with the map (" +
+                                (number_of(d.value("map_ratio", nlohmann::json())) > 0.0
+                                     ? "its points lay " + fixed(number_of(d["map_ratio"]), 1) +
+                                           "x farther from the other LiDARs' surfaces than from its own"
+                                     : "from frame " + frame_text(d.value("disagreed_frame", nlohmann::json())) + " its residual was " +
+                                           fixed(number_of(d.value("residual_ratio", nlohmann::json())), 1) + "x the base's") +
+                                "): the trajectory and map may be wrong; calibrate it with `mlidar slam --calibrate refine`"});
   if (count("suspect_frames") > 0)
     out.push_back({"warn", std::to_string(count("suspect_frames")) + " frame(s) suspect: registered but not trusted, left out of the map"});
   if (metrics.contains("skipped_scans") && metrics["skipped_scans"].is_array() && !metrics["skipped_scans"].empty())

@@ -121,6 +121,20 @@ AxisLayers axis_layers(float fraction, float size) {
 }  // namespace
 
 int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, std::array<Eigen::Vector3f, kMaxNeighbors>& out) const {
+  return search<false>(q, k, max_distance_sq, out, [](const std::vector<std::uint8_t>*, std::size_t) { return true; });
+}
+
+int VoxelMap::nearest_by_source(const Eigen::Vector3f& q, int k, float max_distance_sq, std::uint8_t source, bool same_source,
+                                std::array<Eigen::Vector3f, kMaxNeighbors>& out) const {
+  return search<true>(q, k, max_distance_sq, out, [&](const std::vector<std::uint8_t>* voxel_sources, std::size_t i) {
+    const std::uint8_t of_point = voxel_sources != nullptr && i < voxel_sources->size() ? (*voxel_sources)[i] : kNoSource;
+    return (of_point == source) == same_source;
+  });
+}
+
+template <bool kBySource, typename Keep>
+int VoxelMap::search(const Eigen::Vector3f& q, int k, float max_distance_sq, std::array<Eigen::Vector3f, kMaxNeighbors>& out,
+                     const Keep& keep) const {
   k = std::min(k, kMaxNeighbors);
   if (k <= 0) return 0;
   std::array<float, kMaxNeighbors> best_sq{};
@@ -129,9 +143,16 @@ int VoxelMap::nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, st
   const auto visit = [&](const VoxelKey& key) {
     const auto it = map_.find(key);
     if (it == map_.end()) return;
-    for (const auto& p : points_of(it->second)) {
+    const std::vector<std::uint8_t>* voxel_sources = nullptr;
+    if constexpr (kBySource) {
+      const auto found_sources = sources_.find(key);
+      if (found_sources != sources_.end()) voxel_sources = &found_sources->second;
+    }
+    const std::span<const Eigen::Vector3f> points = points_of(it->second);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3f& p = points[i];
       const float d = (p - q).squaredNorm();
-      if (d > max_distance_sq || (found == k && d >= best_sq[kth])) continue;
+      if (d > max_distance_sq || (found == k && d >= best_sq[kth]) || !keep(voxel_sources, i)) continue;
       int slot = found < k ? found++ : k - 1;  // insertion sort into the sorted prefix
       while (slot > 0 && best_sq[static_cast<std::size_t>(slot - 1)] > d) {
         best_sq[static_cast<std::size_t>(slot)] = best_sq[static_cast<std::size_t>(slot - 1)];

@@ -60,6 +60,9 @@ class VoxelMap {
   /// surrounding voxels with squared distance <= max_distance_sq, nearest
   /// first, written to out; returns how many.
   int nearest(const Eigen::Vector3f& q, int k, float max_distance_sq, std::array<Eigen::Vector3f, kMaxNeighbors>& out) const;
+  /// The same among the points whose source (kNoSource for one added without) is `source` (same_source) or is not.
+  int nearest_by_source(const Eigen::Vector3f& q, int k, float max_distance_sq, std::uint8_t source, bool same_source,
+                        std::array<Eigen::Vector3f, kMaxNeighbors>& out) const;
 
   std::vector<Eigen::Vector3f> points() const;
   /// Each point of points() (same order): its covariance, zero for a point added without one.
@@ -75,6 +78,10 @@ class VoxelMap {
   VoxelKey key_of(const Eigen::Vector3f& p) const { return voxel_key(p, 1.0 / voxel_size_); }
   /// Adds p unless it is not finite or its voxel is full; with `covariance` and a `source`, keeps them beside the point.
   void insert(const Eigen::Vector3f& p, const PointCovariance* covariance, std::uint8_t source = kNoSource);
+  /// nearest() over the points `keep(voxel sources, index in the voxel)` accepts (voxel sources: looked up only with
+  /// kBySource, null when none kept).
+  template <bool kBySource, typename Keep>
+  int search(const Eigen::Vector3f& q, int k, float max_distance_sq, std::array<Eigen::Vector3f, kMaxNeighbors>& out, const Keep& keep) const;
 
   double voxel_size_;
   int max_points_;
