@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_runner.hpp"
+#include "apps/dataset_variants.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 #include "mlidar/io/cloud_file.hpp"
 #include "mlidar/io/extrinsics_io.hpp"
@@ -286,7 +287,7 @@ TEST(CliOdometry, AGivenExtrinsicThatDisagreesWithTheMapIsReported) {
             0);
   io::Extrinsics wrong = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
   const double deg = 0.017453292519943295;
-  Vec6 shock;
+  Vec6 shock;  // the translation in the LiDAR's frame (SE3::exp): the verdict's frame below was measured with it
   shock << 0.1, 0.1, 0.1, 10 * deg, 10 * deg, 10 * deg;
   for (auto& lidar : wrong.lidars)
     if (lidar.name == "right") lidar.T_base_lidar = lidar.T_base_lidar * SE3::exp(shock);
@@ -312,10 +313,7 @@ TEST(CliOdometry, AGivenExtrinsicThatDisagreesWithTheMapIsReported) {
 
   // 0.1 m along each axis alone: the residual stays near the base's, the final map's points of the right LiDAR lie
   // far off the left's planes (the map test).
-  io::Extrinsics shifted = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
-  for (auto& lidar : shifted.lidars)
-    if (lidar.name == "right") lidar.T_base_lidar = SE3(lidar.T_base_lidar.rotation(), lidar.T_base_lidar.translation() + Vec3(0.1, 0.1, 0.1));
-  io::write_extrinsics(dir / "shifted.yaml", shifted);
+  io::write_extrinsics(dir / "shifted.yaml", perturbed_truth(sim, "right", 0.0, 0.1));
   const fs::path shifted_run = dir / "shifted";
   const CliResult by_map =
       run_cli(common + " --extrinsics " + quoted((dir / "shifted.yaml").string()) + " --out " + quoted(shifted_run.string()));

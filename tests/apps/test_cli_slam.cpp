@@ -300,14 +300,9 @@ TEST(CliSlam, AWrongGivenExtrinsicIsFoundAndCalibratedFromTheFirstFrame) {
   const fs::path dir = scratch_dir();
   const fs::path sim = simulate(dir, kWrongFrames, "0,0");
   const fs::path truth = dataset_variant(sim, dir / "truth", false, true);
-  const double deg = 0.017453292519943295;
-  Vec6 shock;
-  shock << 0.1, 0.1, 0.1, 10 * deg, 10 * deg, 10 * deg;
-  io::Extrinsics wrong = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
-  const SE3 T_base_right = wrong.find("right")->T_base_lidar;
-  for (auto& lidar : wrong.lidars)
-    if (lidar.name == "right") lidar.T_base_lidar = T_base_right * SE3::exp(shock);
-  io::write_extrinsics(dir / "wrong.yaml", wrong);
+  const io::Extrinsics truth_extrinsics = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
+  const SE3 T_base_right = truth_extrinsics.find("right")->T_base_lidar;
+  io::write_extrinsics(dir / "wrong.yaml", perturbed_truth(sim, "right", 10.0, 0.1));
   const Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");
   const std::string common = "slam --dataset " + quoted(truth.string()) + " --calibrate fixed --threads 1 ";
 
@@ -356,10 +351,7 @@ TEST(CliSlam, ASmallTranslationErrorIsFoundByTheMapTest) {
   const fs::path dir = scratch_dir();
   const fs::path sim = simulate(dir, kMapFrames, "0,0");
   const fs::path truth = dataset_variant(sim, dir / "truth", false, true);
-  io::Extrinsics wrong = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
-  for (auto& lidar : wrong.lidars)
-    if (lidar.name == "right") lidar.T_base_lidar = SE3(lidar.T_base_lidar.rotation(), lidar.T_base_lidar.translation() + Vec3(0.1, 0.1, 0.1));
-  io::write_extrinsics(dir / "wrong.yaml", wrong);
+  io::write_extrinsics(dir / "wrong.yaml", perturbed_truth(sim, "right", 0.0, 0.1));
   const Trajectory gt = io::read_tum(sim / "groundtruth" / "trajectory.tum");
   const std::string common = "slam --dataset " + quoted(truth.string()) + " --calibrate fixed --threads 1 ";
   const fs::path right_run = dir / "right";

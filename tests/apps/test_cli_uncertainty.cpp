@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli_runner.hpp"
+#include "apps/dataset_variants.hpp"
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/eval/trajectory_metrics.hpp"
 #include "mlidar/io/cloud_file.hpp"
@@ -37,15 +38,12 @@ double ate_rmse(const fs::path& sim, const fs::path& run) {
 
 /// The true extrinsics with `lidar` turned `deg` about each axis and moved `m` along each, its covariance that doubt.
 io::Extrinsics injected(const fs::path& sim, const std::string& lidar, double deg, double m) {
-  io::Extrinsics extrinsics = io::read_extrinsics(sim / "groundtruth" / "extrinsics.yaml");
-  for (io::LidarExtrinsic& l : extrinsics.lidars) {
-    if (l.name != lidar) continue;
-    const double a = deg_to_rad(deg);
-    l.T_base_lidar = SE3(l.T_base_lidar.rotation() * so3_exp(Vec3(a, a, a)), l.T_base_lidar.translation() + Vec3(m, m, m));
-    Vec6 variances;
-    variances << m * m, m * m, m * m, a * a, a * a, a * a;
-    l.covariance = Mat6(variances.asDiagonal());
-  }
+  io::Extrinsics extrinsics = perturbed_truth(sim, lidar, deg, m);
+  const double a = deg_to_rad(deg);
+  Vec6 variances;
+  variances << m * m, m * m, m * m, a * a, a * a, a * a;
+  for (io::LidarExtrinsic& l : extrinsics.lidars)
+    if (l.name == lidar) l.covariance = Mat6(variances.asDiagonal());
   return extrinsics;
 }
 

@@ -31,8 +31,13 @@ io::FrameSource open_source(const OdometryJob& job) {
 
 /// The input's LiDARs with their extrinsics (or --extrinsics FILE's); for uncertainty-aware mapping every LiDAR but
 /// the base frame's own gets alpha times the given covariance, else the configured prior (eq 4.24).
+/// The name the extrinsics are relative to: the dataset's base, else (a folder of clouds) its one LiDAR.
+std::string base_name(const io::FrameSource& source) {
+  return source.dataset_info() ? source.dataset_info()->base : source.lidars().front().name;
+}
+
 std::vector<slam::LidarSetup> lidar_setups(const OdometryJob& job, const io::FrameSource& source, const SlamConfig& config) {
-  const std::string base = source.dataset_info() ? source.dataset_info()->base : source.lidars().front().name;
+  const std::string base = base_name(source);
   std::optional<io::Extrinsics> given;
   if (!job.extrinsics.empty()) given = read_given_extrinsics(job.extrinsics, source, base);
   if (!job.bag.empty() && job.bag_options.extrinsics && job.bag_options.extrinsics->base == base) given = job.bag_options.extrinsics;
@@ -166,12 +171,11 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   summary.gaps = gaps.summary_lines();
   summary.front_end = front_end_lines(results, lidars, config.front_end.recover_rows);
   summary.base_failure = gaps.base_failure(job.max_base_gaps, source.reference_index());
-  const std::string base = source.dataset_info() ? source.dataset_info()->base : lidars.front().name;
-  const auto base_index = static_cast<std::size_t>(
-      std::find_if(lidars.begin(), lidars.end(), [&](const slam::LidarSetup& l) { return l.name == base; }) - lidars.begin());
-  if (base_index < lidars.size() && slam_config.extrinsic_check.residual_ratio > 0.0) {
-    summary.disagreements = check_given_extrinsics(results, lidars, base_index, slam_config.extrinsic_check);
-    add_map_disagreements(odometry, lidars, base_index, slam_config.extrinsic_check, results.size(), summary.disagreements);
+  // lidars follows source.lidars(); a base frame that is no LiDAR (a vehicle's) has no base to compare with.
+  const std::optional<std::size_t> base_index = source.find(base_name(source));
+  if (base_index && slam_config.extrinsic_check.residual_ratio > 0.0) {
+    summary.disagreements = check_given_extrinsics(results, lidars, *base_index, slam_config.extrinsic_check);
+    add_map_disagreements(odometry, lidars, *base_index, slam_config.extrinsic_check, results.size(), summary.disagreements);
   }
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);

@@ -5,33 +5,25 @@
 #include <cmath>
 #include <optional>
 
-#include <Eigen/Eigenvalues>
-
 #include "mlidar/core/median.hpp"
+#include "mlidar/slam/map_matcher.hpp"
 
 namespace mlidar::slam {
 namespace {
 
 constexpr int kNeighbors = 5;
 constexpr float kRadiusSq = 1.0F;
-constexpr double kPlanarity = 0.1;  ///< smallest over middle eigenvalue of the neighbours' scatter, at most
+constexpr double kPlanarity = 0.1;  ///< smallest over middle eigenvalue of the neighbours' covariance, at most
 constexpr double kMinSpreadSq = 0.01;  ///< their variance along the second direction, at least (m^2): 10 cm across
 
 /// |n^T (p - c)| for the plane through `neighbors` (their mean c, normal n), none when they are not planar.
 std::optional<double> plane_distance(const Eigen::Vector3f& p, const std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors>& neighbors) {
-  Vec3 mean = Vec3::Zero();
-  for (int i = 0; i < kNeighbors; ++i) mean += neighbors[static_cast<std::size_t>(i)].cast<double>();
-  mean /= kNeighbors;
-  Mat3 scatter = Mat3::Zero();
-  for (int i = 0; i < kNeighbors; ++i) {
-    const Vec3 d = neighbors[static_cast<std::size_t>(i)].cast<double>() - mean;
-    scatter += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(scatter);
+  Neighbourhood hood;
+  if (!fit_neighbourhood(neighbors, kNeighbors, hood)) return std::nullopt;
+  const Vec3& eigenvalues = hood.eigen.eigenvalues();
   // Planar, and spread across in both directions: 5 points along one scan line fit any plane through that line.
-  if (!(eigen.eigenvalues()(0) <= kPlanarity * eigen.eigenvalues()(1)) || eigen.eigenvalues()(1) < kNeighbors * kMinSpreadSq)
-    return std::nullopt;
-  return std::abs(eigen.eigenvectors().col(0).dot(p.cast<double>() - mean));
+  if (!(eigenvalues(0) <= kPlanarity * eigenvalues(1)) || eigenvalues(1) < kMinSpreadSq) return std::nullopt;
+  return std::abs(hood.eigen.eigenvectors().col(0).dot(p.cast<double>() - hood.mean));
 }
 
 }  // namespace

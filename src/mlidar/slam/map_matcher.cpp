@@ -11,13 +11,9 @@ namespace {
 
 using Neighbours = std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors>;
 
-struct Neighbourhood {
-  Vec3 mean;
-  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
-};
+}  // namespace
 
-/// Mean and covariance eigen-decomposition of the first `count` neighbours.
-bool fit(const Neighbours& points, int count, Neighbourhood& out) {
+bool fit_neighbourhood(const Neighbours& points, int count, Neighbourhood& out) {
   Vec3 mean = Vec3::Zero();
   for (int i = 0; i < count; ++i) mean += points[static_cast<std::size_t>(i)].cast<double>();
   mean /= count;
@@ -31,8 +27,6 @@ bool fit(const Neighbours& points, int count, Neighbourhood& out) {
   return out.eigen.info() == Eigen::Success;
 }
 
-}  // namespace
-
 std::optional<PlaneCoefficients> match_plane(const VoxelMap& plane_map, const Vec3& q_world, float search_radius_sq,
                                              const RegistrationConfig& config) {
   Neighbours near;
@@ -42,7 +36,7 @@ std::optional<PlaneCoefficients> match_plane(const VoxelMap& plane_map, const Ve
   const auto extra_sq = static_cast<float>(config.plane_extra_radius_m * config.plane_extra_radius_m);
   while (count > config.neighbors && (near[static_cast<std::size_t>(count - 1)] - q).squaredNorm() > extra_sq) --count;
   Neighbourhood hood;
-  if (count < 3 || !fit(near, count, hood)) return std::nullopt;
+  if (count < 3 || !fit_neighbourhood(near, count, hood)) return std::nullopt;
   // Colinear neighbours (one scan line) leave the normal's direction free about the line.
   if (hood.eigen.eigenvalues()(1) < config.plane_spread * hood.eigen.eigenvalues()(0)) return std::nullopt;
   // Narrower than the range noise: the noise along the beams, not the surface, sets the normal.
@@ -58,7 +52,7 @@ std::optional<MapLine> match_line(const VoxelMap& edge_map, const Vec3& q_world,
   Neighbours near;
   const int count = edge_map.nearest(q_world.cast<float>(), config.neighbors, search_radius_sq, near);
   Neighbourhood hood;
-  if (count < 3 || !fit(near, count, hood)) return std::nullopt;
+  if (count < 3 || !fit_neighbourhood(near, count, hood)) return std::nullopt;
   const Vec3 values = hood.eigen.eigenvalues();
   if (values(2) < config.edge_linearity * values(1)) return std::nullopt;
   const Vec3 direction = hood.eigen.eigenvectors().col(2);

@@ -7,7 +7,10 @@
 //   line:  largest eigenvalue >= edge_linearity x middle one and every
 //          neighbour within edge_tolerance_m of the line.
 // Shared by scan-to-map registration and the back end's window correspondences.
+#include <array>
 #include <optional>
+
+#include <Eigen/Eigenvalues>
 
 #include "mlidar/core/se3.hpp"
 #include "mlidar/slam/residuals.hpp"
@@ -21,6 +24,14 @@ struct MapLine {
   Vec3 point = Vec3::Zero();
   Vec3 direction = Vec3::UnitX();
 };
+
+/// A neighbourhood's mean and the eigen-decomposition of its covariance (ascending eigenvalues, m^2).
+struct Neighbourhood {
+  Vec3 mean = Vec3::Zero();
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+};
+/// Fits the first `count` of `points` (VoxelMap::nearest's output); false when the decomposition failed.
+bool fit_neighbourhood(const std::array<Eigen::Vector3f, VoxelMap::kMaxNeighbors>& points, int count, Neighbourhood& out);
 
 /// The plane of q_world's map neighbours within sqrt(search_radius_sq), or none.
 std::optional<PlaneCoefficients> match_plane(const VoxelMap& plane_map, const Vec3& q_world, float search_radius_sq,
