@@ -1,14 +1,13 @@
 // `mlidar odometry`: multi-LiDAR scan-to-map odometry over a dataset or a folder of clouds.
 #include <cmath>
-#include <iomanip>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include "apps/mlidar/bag_options.hpp"
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
+#include "mlidar/calib/extrinsic_check.hpp"
 #include "mlidar/pipelines/odometry_job.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/report/run_report.hpp"
@@ -16,13 +15,6 @@
 
 namespace mlidar::cli {
 namespace {
-
-std::string one_decimal(double value) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(1) << value;
-  return text.str();
-}
-
 
 struct OdometryOptions {
   std::string dataset;
@@ -71,8 +63,7 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
             << summary.degenerate_frames << " degenerate, " << summary.lost_frames << " lost, " << summary.suspect_frames.size()
             << " suspect\n";
   for (const auto& line : summary.front_end) std::cout << "note: " << line << '\n';
-  std::cout << "note: last pose 1-sigma " << pipelines::pose_sigma_words(summary.last_pose_covariance)
-            << " (grown from 0 at the first frame; every frame's in pose_covariance.txt)\n";
+  std::cout << "note: " << pipelines::last_pose_note(summary.last_pose_covariance, summary.lost_at_end) << '\n';
   if (summary.degenerate_frames > 0) {
     std::cerr << "warning: " << summary.degenerate_frames << " frame(s) degenerate (translation weakly constrained, e.g. a corridor): ";
     for (std::size_t i = 0; i < summary.degenerate_directions.size(); ++i)
@@ -81,18 +72,15 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
     std::cerr << "; that translation was held at the motion prior, not measured (metrics.json per_frame weak_direction)\n";
   }
   std::cerr << suspect_frames_warning(summary.suspect_frames);
+  std::cerr << pipelines::map_restart_warning(summary.map_restarts, summary.restart_after_lost);
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
   if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';
   for (const pipelines::GivenExtrinsicDisagreement& d : summary.disagreements)
     std::cerr << "warning: " << d.lidar << ": the given extrinsic disagrees with the map ("
-              << (d.map_ratio > 0.0 ? "its points in the final map lay " + one_decimal(d.map_ratio) +
-                                          "x farther from the other LiDARs' surfaces than from its own"
-                                    : "at frame " + std::to_string(d.frame) + " its residual was " +
-                                          one_decimal(d.residual_ratio) +
-                                          "x the base's, the median of the last extrinsic_check.frames frames")
-              << "; right extrinsics stay near 1): the trajectory and map may be wrong; check it, or calibrate it with "
-              << "`mlidar slam --calibrate refine`\n";
+              << calib::describe(
+                     {.frame = d.frame, .residual_ratio = d.residual_ratio, .map_ratio = d.map_ratio, .reference = d.compared_with})
+              << "): the trajectory and map may be wrong; check it, or calibrate it with `mlidar slam --calibrate refine`\n";
   return summary.trusted() ? 0 : 1;
 }
 

@@ -9,6 +9,7 @@
 #include "apps/mlidar/bag_options.hpp"
 #include "apps/mlidar/commands.hpp"
 #include "apps/mlidar/progress_bar.hpp"
+#include "mlidar/calib/extrinsic_check.hpp"
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/pipelines/odometry_metrics.hpp"
 #include "mlidar/pipelines/slam_job.hpp"
@@ -68,16 +69,9 @@ std::string disagreement_warning(const pipelines::SlamLidarReport& lidar) {
   const pipelines::ExtrinsicDisagreement& d = *lidar.disagreement;
   std::ostringstream text;
   text << std::setprecision(2) << std::fixed;
-  text << "warning: " << lidar.name << ": the given extrinsic disagrees with the map ";
-  if (d.frames_lost)
-    text << "(no frame after the first could be registered with the given extrinsics, " << pipelines::SlamEstimator::kLostFromStartFrames
-         << " lost in a row: any of them may be wrong); ";
-  else if (d.map_ratio > 0.0)
-    text << "(at frame " << d.frame << " its points in the map lay " << d.map_ratio
-         << "x farther from the other LiDARs' surfaces than from its own; right extrinsics stay near 1); ";
-  else
-    text << "(at frame " << d.frame << " its residual was " << d.residual_ratio
-         << "x the base's, the median of the last extrinsic_check.frames frames; right extrinsics stay near 1); ";
+  text << "warning: " << lidar.name << ": the given extrinsic disagrees with the map ("
+       << calib::describe({.frame = d.frame, .residual_ratio = d.residual_ratio, .map_ratio = d.map_ratio, .frames_lost = d.frames_lost})
+       << "); ";
   if (!d.recalibrated) {
     text << "the run used it as given, its trajectory and map may be wrong: check it, or run --calibrate refine\n";
     return text.str();
@@ -124,12 +118,12 @@ int run_slam(SlamOptions options, const CliContext& context) {
   std::cout << "wrote " << options.job.out.string() << ": " << summary.frames << " frames, " << summary.mean_frame_seconds * 1e3
             << " ms per frame, " << summary.lost_frames << " lost, " << summary.suspect_frames.size() << " suspect\n";
   for (const auto& lidar : summary.lidars) print_lidar(lidar);
-  std::cout << "note: last pose 1-sigma " << pipelines::pose_sigma_words(summary.last_pose_covariance)
-            << " (grown from 0 at the first frame; every frame's in pose_covariance.txt)\n";
+  std::cout << "note: " << pipelines::last_pose_note(summary.last_pose_covariance, summary.lost_at_end) << '\n';
   if (!summary.all_converged())
     std::cerr
         << "warning: some LiDAR's calibration did not converge; its extrinsic in extrinsics.yaml has no covariance (see metrics.json)\n";
   std::cerr << suspect_frames_warning(summary.suspect_frames);
+  std::cerr << pipelines::map_restart_warning(summary.map_restarts, summary.restart_after_lost);
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
   if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';

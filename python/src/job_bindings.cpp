@@ -42,6 +42,7 @@ py::dict trajectory_summary(const Summary& summary, const std::filesystem::path&
   result["out"] = out.string();
   result["frames"] = summary.frames;
   result["lost_frames"] = summary.lost_frames;
+  result["map_restarts"] = summary.map_restarts;
   result["suspect_frames"] = summary.suspect_frames;
   result["mean_frame_seconds"] = summary.mean_frame_seconds;
   result["trajectory"] = trajectory_array(summary.trajectory);

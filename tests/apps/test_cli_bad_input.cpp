@@ -154,6 +154,44 @@ TEST(CliSkippedScans, AnUnusableScanIsReportedAndTheBaseLosingMostFailsTheJob) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
 }
 
+// Every LiDAR without a scan in the last two frames: those frames are lost, their poses predictions whose doubt grows
+// with each; the note on the last pose says so instead of printing its sigma as an estimate's.
+TEST(CliSkippedScans, TheLastPoseOfARunEndingInLostFramesIsCalledAPrediction) {
+  const fs::path dir = scratch_dir();
+  const fs::path data = copy_of_small_dataset(dir / "data");
+  for (const char* lidar : {"left", "right"})
+    for (const char* frame : {"000010.pcd", "000011.pcd"}) replace_scan(data / "scans" / lidar / frame, 0, 0);
+  for (const std::string command : {"odometry", "slam --calibrate fixed"}) {
+    const CliResult r =
+        run_cli(command + " --max-base-gaps 0.5 --dataset " + quoted(data.string()) + " --out " + quoted((dir / "run").string()));
+    EXPECT_EQ(r.exit_code, 1) << command << r.output;
+    EXPECT_NE(r.output.find("2 lost"), std::string::npos) << command << r.output;
+    EXPECT_NE(r.output.find(": a prediction, not an estimate (the last 2 frame(s) were lost"), std::string::npos) << command << r.output;
+  }
+}
+
+// The roof LiDAR of a car at 7.5 m/s without scans for 0.8 s after its first: its velocity was never measured, and
+// from the start's pose the registrations fail. After 5 in a row the next frame starts a new local map: warned,
+// metrics.json map_restarts, exit 1; the frames after it are registered again.
+TEST(CliSkippedScans, FailedRegistrationsInARowStartANewLocalMap) {
+  const fs::path dir = scratch_dir();
+  const fs::path sim = dir / "sim";
+  ASSERT_EQ(
+      run_cli("simulate drive --rig rv --scene campus --trajectory vehicle --frames 24 --seed 2 --out " + quoted(sim.string())).exit_code,
+      0);
+  for (int k = 1; k <= 8; ++k) replace_scan(sim / "scans/top" / ("00000" + std::to_string(k) + ".pcd"), 0, 0);
+  const CliResult r =
+      run_cli("odometry --lidars top --threads 1 --dataset " + quoted(sim.string()) + " --out " + quoted((dir / "run").string()));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("warning: the local map was started again at frame 14, after 5 failed registrations in a row"), std::string::npos)
+      << r.output;
+  const nlohmann::json metrics = nlohmann::json::parse(std::ifstream(dir / "run" / "metrics.json"));
+  EXPECT_EQ(metrics["map_restarts"], nlohmann::json::array({14})) << metrics["map_restarts"];
+  EXPECT_EQ(metrics["lost_frames"], 14);  // 8 without a scan, 5 failed, the restart frame
+  for (std::size_t k = 15; k < 24; ++k) EXPECT_FALSE(metrics["per_frame"][k]["lost"].get<bool>()) << "frame " << k;
+  EXPECT_TRUE(metrics["per_frame"][14]["map_restarted"].get<bool>());
+}
+
 TEST(CliOptions, NumbersOutOfRangeAreExitTwoNamingTheOptionAndWriteNothing) {
   const fs::path dir = scratch_dir();
   const std::string data = quoted(small_dataset().string());

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -75,6 +76,22 @@ TEST(ExtrinsicCheck, AfterAResetTheLidarIsJudgedAfreshAndAZeroRatioTurnsTheCheck
   EXPECT_THROW(ExtrinsicCheck(2, {.frames = 0}), std::invalid_argument);
   EXPECT_THROW(ExtrinsicCheck(2, {.residual_ratio = -1.0}), std::invalid_argument);
   EXPECT_THROW(check.update(std::vector<double>{0.03}, {false}), std::invalid_argument);
+}
+
+// The one text of a verdict (terminal slam and odometry, report.html): the evidence that judged it, its number to
+// one decimal and what it was compared with.
+TEST(ExtrinsicCheck, TheEvidenceInWordsNamesWhatJudgedTheExtrinsic) {
+  EXPECT_EQ(describe({.frame = 5, .residual_ratio = 3.14159}),
+            "at frame 5 its residual was 3.1x the base's, the median of the last extrinsic_check.frames frames; right extrinsics "
+            "stay near 1");
+  EXPECT_EQ(describe({.frame = 29, .map_ratio = 17.84}),
+            "at frame 29 its points in the map lay 17.8x farther from the other LiDARs' surfaces than from its own; right "
+            "extrinsics stay near 1");
+  EXPECT_EQ(describe({.frame = 5, .frames_lost = true}),
+            "the frames after the first could not be registered with the given extrinsics (lost from the start): any of them "
+            "may be wrong");
+  const std::string vehicle = describe({.frame = 40, .residual_ratio = 2.34, .reference = "the reference LiDAR top"});
+  EXPECT_NE(vehicle.find("at frame 40 its residual was 2.3x the reference LiDAR top's,"), std::string::npos) << vehicle;
 }
 
 }  // namespace

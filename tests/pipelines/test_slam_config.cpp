@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 73u);
+  EXPECT_EQ(slam_config_keys().size(), 74u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -74,6 +74,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   c.odometry.edge_voxel_m = 0.3;
   c.odometry.local_map_radius_m = 80.0;
   c.odometry.registration.max_iterations = 12;
+  c.odometry.restart_after_lost = 7;
   c.odometry.registration.huber_delta_m = 0.05;
   c.odometry.refine_deskew = true;
   c.odometry.registration.selection.method = slam::SelectionMethod::kRandom;
@@ -98,6 +99,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   EXPECT_FALSE(back.shock.relative_to_others);
   EXPECT_TRUE(back.window.refine_odometry);
   EXPECT_EQ(back.odometry.registration.max_iterations, 12);
+  EXPECT_EQ(back.odometry.restart_after_lost, 7u);
   EXPECT_EQ(back.odometry.registration.huber_delta_m, 0.05);
   EXPECT_TRUE(back.odometry.refine_deskew);
   EXPECT_EQ(back.odometry.registration.selection.method, slam::SelectionMethod::kRandom);
@@ -131,7 +133,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  plane_voxel_m: 0.7\n  edge_voxel_m: 0.3\n  local_map_radius_m: 80\n  max_iterations: 12\n  refine_deskew: true\n"
       "  deskew_in_registration: false\n  plane_neighbors_max: 8\n  voxel_plane_neighbors_max: 6\n  plane_extra_radius_m: 0.3\n"
       "  plane_min_extent_sigmas: 0.8\n  huber_delta_m: 0.05\n"
-      "  recover_rows: false\n  recover_rows_max_skip: 4\n  voxel_coarse_stride: 3\n"
+      "  recover_rows: false\n  recover_rows_max_skip: 4\n  voxel_coarse_stride: 3\n  restart_after_lost: 9\n"
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
       "  degeneracy_interval_s: 2\n  epsilon: 0.4\n  time_budget_ms: 3\n  seed: 12\n  min_features: 40\n"
@@ -180,15 +182,16 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(c.shock.min_relative_jump, 0.4);
   EXPECT_EQ(c.shock.consecutive, 7u);
   EXPECT_FALSE(c.shock.relative_to_others);
-  EXPECT_EQ(c.extrinsic_check.frames, 15u);
-  EXPECT_EQ(c.extrinsic_check.residual_ratio, 2.5);
+  EXPECT_EQ(c.extrinsic_check.residual.frames, 15u);
+  EXPECT_EQ(c.extrinsic_check.residual.residual_ratio, 2.5);
   EXPECT_EQ(c.extrinsic_check.map_first_frames, 40u);
   EXPECT_EQ(c.extrinsic_check.map_ratio, 4.0);
-  EXPECT_FALSE(c.recalibrate_disagreeing);
+  EXPECT_FALSE(c.extrinsic_check.recalibrate);
   EXPECT_EQ(c.odometry.plane_voxel_m, 0.7);
   EXPECT_EQ(c.odometry.edge_voxel_m, 0.3);
   EXPECT_EQ(c.odometry.local_map_radius_m, 80.0);
   EXPECT_EQ(c.odometry.registration.max_iterations, 12);
+  EXPECT_EQ(c.odometry.restart_after_lost, 9u);
   EXPECT_TRUE(c.odometry.refine_deskew);
   EXPECT_FALSE(c.odometry.deskew_in_registration);
   const slam::SelectionConfig& sel = c.odometry.registration.selection;

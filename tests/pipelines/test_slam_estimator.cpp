@@ -245,7 +245,7 @@ TEST(SlamEstimator, NoFrameRegisteredWithTheGivenExtrinsicsSendsThemToCalibratio
   const auto scan_of = [&](std::size_t k, std::size_t i, const sim::SimLidar& lidar) { return std::optional(sweep(drive, lidar, k, i)); };
 
   pipelines::SlamConfig unchecked;
-  unchecked.extrinsic_check.residual_ratio = 0.0;
+  unchecked.extrinsic_check.residual.residual_ratio = 0.0;
   SlamEstimator as_given(unchecked, given, ExtrinsicSource::fixed);
   const std::vector<SlamFrame> lost = run(as_given, drive, scan_of);
   for (std::size_t k = 1; k < kFrames; ++k) EXPECT_TRUE(lost[k].lost) << "frame " << k << ": not the case this test is about";
@@ -262,6 +262,17 @@ TEST(SlamEstimator, NoFrameRegisteredWithTheGivenExtrinsicsSendsThemToCalibratio
   EXPECT_TRUE(disagreement->recalibrated);
   EXPECT_EQ(disagreement->frame, verdict);
   EXPECT_EQ(frames[verdict].lidars[1].role, LidarRole::calibrating);
+  // A stream goes on in place: after restart_after_lost (5) failed registrations the next frame starts a new map, the
+  // base's alone now, and the frames after it are registered again, their motion since the restart the truth's.
+  const std::size_t restart = verdict + 1;
+  EXPECT_TRUE(frames[restart].map_restarted);
+  EXPECT_TRUE(frames[restart].lost);
+  const auto truth_at = [&](std::size_t k) { return drive.trajectory.T_world_base(drive.stamps[k]); };
+  for (std::size_t k = restart + 1; k < kFrames; ++k) {
+    EXPECT_FALSE(frames[k].lost) << "frame " << k;
+    const SE3 truth_motion = truth_at(restart).inverse() * truth_at(k);
+    EXPECT_LT(translation_error_m(truth_motion, frames[restart].T_world_base.inverse() * frames[k].T_world_base), 0.05) << "frame " << k;
+  }
   // Told from the first frame (what `mlidar slam` does next: the run started again), the base registers alone
   // while the front calibrates, every frame near the truth; the LiDAR is not judged again.
   SlamEstimator told(pipelines::SlamConfig{}, given, ExtrinsicSource::fixed,

@@ -41,8 +41,9 @@ nlohmann::json pose_json(const SE3& T) {
 
 /// A slam-like run: `right` converged (windows from frame 5), `left` never started.
 nlohmann::json slam_metrics(const SE3& T_right) {
-  nlohmann::json metrics = {{"frames", kFrames}, {"calibrate", "online"}, {"lidars", {"top", "right", "left"}},
-                            {"lost_frames", 1},  {"suspect_frames", 0},   {"convergence", {{"lambda_calib", 70.0}}}};
+  nlohmann::json metrics = {{"frames", kFrames},  {"calibrate", "online"}, {"lidars", {"top", "right", "left"}},
+                            {"lost_frames", 1},   {"suspect_frames", 0},   {"convergence", {{"lambda_calib", 70.0}}},
+                            {"map_restarts", {7}}};
   for (const char* stage : {"load", "odometry", "calibration"})
     metrics["stages"][stage] = {{"mean", 0.01}, {"p50", 0.01}, {"p95", 0.02}, {"max", 0.03}};
   metrics["total_seconds"] = {{"mean", 0.02}, {"p50", 0.02}, {"p95", 0.03}, {"max", 0.05}};
@@ -142,6 +143,7 @@ TEST(RunReport, HasTheSectionsItsDataAllowWithVerdictsInWords) {
             std::string::npos)
       << summary;
   EXPECT_NE(summary.find("<li class=\"bad\">1 frame(s) could not be registered"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("<li class=\"bad\">the local map was started again at frame(s) 7 after"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("top:"), std::string::npos) << "the base has no verdict";
   // Error against the truth, made 1 deg / 2 cm off above; NEES by hand: e^T (1e-4 I)^-1 e.
   const double nees = (0.02 * 0.02 + deg_to_rad(1.0) * deg_to_rad(1.0)) / 1e-4;

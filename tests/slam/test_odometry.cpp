@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 
 #include <gtest/gtest.h>
 
@@ -265,6 +266,45 @@ TEST(Odometry, ASingleSixteenBeamLidarAtSpeedIsNotLostAtItsSecondFrame) {
   });
   EXPECT_LT(worst.m, 0.1);
   EXPECT_LT(worst.deg, 0.2);
+}
+
+// A gap in the input right after the first frame (no scan for 0.8 s at 7.5 m/s): the velocity was never measured, so
+// the prediction stays at the start, 6 m behind, where the registrations fail (checked with restarts off: every
+// later frame lost). After restart_after_lost failed registrations the next frame starts a new map at its predicted
+// pose; from there the relative motion is measured again, and only the restart frame's offset is unknown.
+TEST(Odometry, FailedRegistrationsInARowStartANewMapAndTheMotionAfterItIsMeasuredAgain) {
+  constexpr std::size_t kFrames = 24, kGap = 8;
+  Drive drive = simulate_drive("rv", kFrames, "vehicle", true, "campus", 2, 300);
+  drive.lidars.resize(1);  // the top RS-LiDAR-16 alone
+  for (Frame& frame : drive.frames) frame.scans.resize(1);
+  for (std::size_t k = 1; k <= kGap; ++k) drive.frames[k].scans[0] = Scan{};
+
+  OdometryConfig never;
+  never.restart_after_lost = 0;
+  Odometry stuck(never, drive.lidars);
+  std::size_t lost_after_gap = 0;
+  for (std::size_t k = 0; k < kFrames; ++k) lost_after_gap += stuck.process(drive.frames[k]).lost() && k > kGap ? 1 : 0;
+  EXPECT_EQ(lost_after_gap, kFrames - kGap - 1) << "the case this test is about";
+
+  Odometry odometry({}, drive.lidars);
+  std::optional<std::size_t> restart;
+  SE3 T_world_restart;
+  for (std::size_t k = 0; k < kFrames; ++k) {
+    const FrameResult result = odometry.process(drive.frames[k]);
+    EXPECT_EQ(result.lost(), k > 0 && (k <= kGap || !restart || k == *restart)) << "frame " << k;
+    if (result.map_restarted) {
+      EXPECT_FALSE(restart) << "one restart, frame " << k;
+      restart = k;
+      T_world_restart = result.T_world_base;
+    } else if (restart && k > *restart) {
+      const SE3 truth = drive.truth[*restart].inverse() * drive.truth[k];
+      const SE3 error = truth.inverse() * (T_world_restart.inverse() * result.T_world_base);
+      EXPECT_LT(error.translation().norm(), 0.05) << "frame " << k;
+      EXPECT_LT(rotation_angle_deg(error), 0.2) << "frame " << k;
+    }
+  }
+  ASSERT_TRUE(restart);
+  EXPECT_EQ(*restart, kGap + 1 + OdometryConfig{}.restart_after_lost);  // 5 failed registrations, then the restart
 }
 
 /// The drive's LiDARs with LiDAR 1's extrinsic turned 10 deg about each axis and moved 0.1 m along each (Table 4.6's

@@ -40,8 +40,10 @@ TEST(ResidualHistory, IsTheMedianOfTheLastOnes) {
 
 TEST(TrustRule, RelativeBoundHasAFloorAndNeedsAHistory) {
   const slam::TrustConfig config;  // ratio 2, floor 0.03 m, absolute 0.2 m / 0.5
-  const slam::TrustRule none{config, std::nan("")};
-  EXPECT_TRUE(none.trusted(candidate(0.19, 0.9)));
+  const slam::TrustRule none{config, std::nan("")};  // no history: an absolute bound of 0.06 m
+  EXPECT_TRUE(none.trusted(candidate(0.059, 0.9)));
+  EXPECT_FALSE(none.trusted(candidate(0.19, 0.9)));
+  EXPECT_TRUE(none.acceptable(candidate(0.19, 0.9)));
   EXPECT_FALSE(none.acceptable(candidate(0.21, 0.9)));
   EXPECT_FALSE(none.acceptable(candidate(0.05, 0.4)));
   const slam::TrustRule recent{config, 0.05};

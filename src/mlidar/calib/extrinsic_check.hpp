@@ -16,18 +16,14 @@
 #include <deque>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace mlidar::calib {
 
 struct ExtrinsicCheckConfig {
   std::size_t frames = 20;      ///< ratios in the median (a decision needs this many)
-  double residual_ratio = 2.0;  ///< median ratio to the base's residual above which an extrinsic disagrees (0: no check at all)
-  /// The map test (slam/map_consistency.hpp) after this many frames and again at twice as many each time (30, 60,
-  /// 120, ...; 0: never; the odometry job: on its final map): a LiDAR's points map_ratio times farther from the other
-  /// LiDARs' planes than from its own disagree. Doubling keeps its cost (about 50 ms for 4 LiDARs) off long runs.
-  std::size_t map_first_frames = 30;
-  double map_ratio = 3.0;
+  double residual_ratio = 2.0;  ///< median ratio to the base's residual above which an extrinsic disagrees (0: no check)
 };
 
 class ExtrinsicCheck {
@@ -53,5 +49,19 @@ class ExtrinsicCheck {
   ExtrinsicCheckConfig config_;
   std::vector<LidarState> lidars_;
 };
+
+/// What showed a given extrinsic wrong: ExtrinsicCheck's median residual ratio, the map test's ratio
+/// (slam/map_consistency.hpp) or a start whose frames were all lost, whichever judged it.
+struct DisagreementEvidence {
+  std::size_t frame = 0;               ///< the frame of the verdict
+  double residual_ratio = -1.0;        ///< > 0: judged by ExtrinsicCheck (the median over `frames` frames)
+  double map_ratio = -1.0;             ///< > 0: judged by the map test
+  bool frames_lost = false;            ///< judged because the frames after the first were all lost (the slam job's start)
+  std::string reference = "the base";  ///< whose residual it was divided by, in words ("the reference LiDAR top")
+};
+
+/// The evidence in words, one clause for the terminal and report.html, e.g. "at frame 5 its residual was 3.1x the
+/// base's, the median of the last extrinsic_check.frames frames; right extrinsics stay near 1".
+std::string describe(const DisagreementEvidence& evidence);
 
 }  // namespace mlidar::calib

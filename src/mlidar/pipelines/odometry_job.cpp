@@ -29,13 +29,13 @@ io::FrameSource open_source(const OdometryJob& job) {
   return io::FrameSource::dataset(job.dataset, job.lidars);
 }
 
-/// The input's LiDARs with their extrinsics (or --extrinsics FILE's); for uncertainty-aware mapping every LiDAR but
-/// the base frame's own gets alpha times the given covariance, else the configured prior (eq 4.24).
 /// The name the extrinsics are relative to: the dataset's base, else (a folder of clouds) its one LiDAR.
 std::string base_name(const io::FrameSource& source) {
   return source.dataset_info() ? source.dataset_info()->base : source.lidars().front().name;
 }
 
+/// The input's LiDARs with their extrinsics (or --extrinsics FILE's); for uncertainty-aware mapping every LiDAR but
+/// the base frame's own gets alpha times the given covariance, else the configured prior (eq 4.24).
 std::vector<slam::LidarSetup> lidar_setups(const OdometryJob& job, const io::FrameSource& source, const SlamConfig& config) {
   const std::string base = base_name(source);
   std::optional<io::Extrinsics> given;
@@ -92,13 +92,15 @@ std::vector<std::string> front_end_lines(const std::vector<slam::FrameResult>& r
   return lines;
 }
 
-/// Each auxiliary LiDAR's given extrinsic judged against the map over the frames' residuals (calib::ExtrinsicCheck;
-/// lost frames left out), the base first.
 /// Planar neighbourhoods the map test needs of a LiDAR, of its own and of the others', to judge it.
 constexpr std::size_t kMapTestPlanes = 100;
 
+/// Each LiDAR's given extrinsic but lidars[base]'s judged against the map over the frames' residuals
+/// (calib::ExtrinsicCheck; lost frames left out).
+
 std::vector<GivenExtrinsicDisagreement> check_given_extrinsics(const std::vector<slam::FrameResult>& results,
                                                                const std::vector<slam::LidarSetup>& lidars, std::size_t base,
+                                                               const std::string& compared_with,
                                                                const calib::ExtrinsicCheckConfig& config) {
   std::vector<std::size_t> order{base};  // the check's LiDAR j is lidars[order[j]]
   for (std::size_t i = 0; i < lidars.size(); ++i)
@@ -113,7 +115,7 @@ std::vector<GivenExtrinsicDisagreement> check_given_extrinsics(const std::vector
     std::vector<double> ordered;
     for (const std::size_t i : order) ordered.push_back(residual[i]);
     for (const std::size_t j : check.update(ordered, judged))
-      found.push_back({lidars[order[j]].name, k, check.median_ratio(j).value_or(0.0), -1.0});
+      found.push_back({lidars[order[j]].name, k, check.median_ratio(j).value_or(0.0), -1.0, compared_with});
   }
   return found;
 }
@@ -121,7 +123,7 @@ std::vector<GivenExtrinsicDisagreement> check_given_extrinsics(const std::vector
 /// The map test (slam/map_consistency.hpp) on the final map: each auxiliary LiDAR not judged yet whose points lie
 /// map_ratio times farther from the others' planes than from its own (the map's sources are the odometry's order).
 void add_map_disagreements(const slam::Odometry& odometry, const std::vector<slam::LidarSetup>& lidars, std::size_t base,
-                           const calib::ExtrinsicCheckConfig& config, std::size_t frames, std::vector<GivenExtrinsicDisagreement>& found) {
+                           const GivenExtrinsicChecks& config, std::size_t frames, std::vector<GivenExtrinsicDisagreement>& found) {
   if (config.map_first_frames == 0 || frames == 0) return;
   const std::vector<slam::SourceConsistency> consistency = slam::map_consistency(odometry.plane_map(), lidars.size());
   for (std::size_t i = 0; i < consistency.size(); ++i) {
@@ -131,7 +133,7 @@ void add_map_disagreements(const slam::Odometry& odometry, const std::vector<sla
     const double ratio = slam::consistency_ratio(consistency, i);
     if (c.source == base || judged || c.self_planes < kMapTestPlanes || c.cross_planes < kMapTestPlanes || !(ratio > config.map_ratio))
       continue;
-    found.push_back({name, frames - 1, -1.0, ratio});
+    found.push_back({name, frames - 1, -1.0, ratio, "the other LiDARs"});
   }
 }
 
@@ -160,10 +162,13 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
     if (progress) progress(static_cast<int>(k + 1), static_cast<int>(source.frames()));
   }
   summary.frames = results.size();
+  summary.restart_after_lost = config.restart_after_lost;
   for (std::size_t k = 0; k < results.size(); ++k) {
     const slam::FrameResult& r = results[k];
     summary.degenerate_frames += r.registration.degenerate ? 1 : 0;
     summary.lost_frames += r.lost() ? 1 : 0;
+    summary.lost_at_end = r.lost() ? summary.lost_at_end + 1 : 0;
+    if (r.map_restarted) summary.map_restarts.push_back(k);
     if (r.suspect()) summary.suspect_frames.push_back(k);
     for (const double s : r.seconds) summary.mean_frame_seconds += s / static_cast<double>(results.size());
   }
@@ -171,11 +176,15 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
   summary.gaps = gaps.summary_lines();
   summary.front_end = front_end_lines(results, lidars, config.front_end.recover_rows);
   summary.base_failure = gaps.base_failure(job.max_base_gaps, source.reference_index());
-  // lidars follows source.lidars(); a base frame that is no LiDAR (a vehicle's) has no base to compare with.
-  const std::optional<std::size_t> base_index = source.find(base_name(source));
-  if (base_index && slam_config.extrinsic_check.residual_ratio > 0.0) {
-    summary.disagreements = check_given_extrinsics(results, lidars, *base_index, slam_config.extrinsic_check);
-    add_map_disagreements(odometry, lidars, *base_index, slam_config.extrinsic_check, results.size(), summary.disagreements);
+  // lidars follows source.lidars(). The others are judged against the base LiDAR, or, where the base frame is no
+  // LiDAR (a vehicle's), against the dataset's reference_lidar, as slam does: only extrinsics relative to one
+  // another can disagree with a map.
+  const std::optional<std::size_t> reference = source.reference_index();
+  if (reference && slam_config.extrinsic_check.enabled()) {
+    const std::string& reference_name = lidars[*reference].name;
+    const std::string compared_with = reference_name == base_name(source) ? "the base" : "the reference LiDAR " + reference_name;
+    summary.disagreements = check_given_extrinsics(results, lidars, *reference, compared_with, slam_config.extrinsic_check.residual);
+    add_map_disagreements(odometry, lidars, *reference, slam_config.extrinsic_check, results.size(), summary.disagreements);
   }
   io::write_tum(job.out / "trajectory.tum", summary.trajectory);
   io::write_kitti_poses(job.out / "trajectory.kitti", summary.trajectory);
@@ -191,7 +200,8 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
     metrics["extrinsic_check"].push_back({{"lidar", d.lidar},
                                           {"disagreed_frame", d.frame},
                                           {"residual_ratio", d.residual_ratio > 0.0 ? nlohmann::json(d.residual_ratio) : nlohmann::json()},
-                                          {"map_ratio", d.map_ratio > 0.0 ? nlohmann::json(d.map_ratio) : nlohmann::json()}});
+                                          {"map_ratio", d.map_ratio > 0.0 ? nlohmann::json(d.map_ratio) : nlohmann::json()},
+                                          {"compared_with", d.compared_with}});
   const std::string text = metrics.dump(2);
   io::write_atomically(job.out / "metrics.json", [&](std::ostream& out) { out << text << '\n'; });
   return summary;

@@ -50,6 +50,9 @@ struct GivenExtrinsicDisagreement {
   std::size_t frame = 0;        ///< the frame the median ratio crossed the limit (the last frame: the map test)
   double residual_ratio = 0.0;  ///< that median of the LiDAR's residual over the base's (-1: judged by the map test)
   double map_ratio = -1.0;      ///< the map test's ratio on the final map (slam/map_consistency.hpp; -1: not judged by it)
+  /// What it was compared with, in words: "the base" or, where the base frame is no LiDAR (a vehicle's), "the
+  /// reference LiDAR NAME" (dataset.yaml reference_lidar) for the residual ratio; "the other LiDARs" for the map test.
+  std::string compared_with = "the base";
 };
 
 struct OdometryJobSummary {
@@ -58,6 +61,9 @@ struct OdometryJobSummary {
   /// Of those, how many had their weak translation closest to each base axis (base_axis_words), most first.
   std::vector<std::pair<std::string, std::size_t>> degenerate_directions;
   std::size_t lost_frames = 0;
+  std::size_t lost_at_end = 0;              ///< lost frames in a row at the end of the run (the last pose a prediction)
+  std::vector<std::size_t> map_restarts;    ///< frames that started a new local map after frames lost in a row
+  std::size_t restart_after_lost = 0;       ///< ... after this many (odometry.restart_after_lost)
   std::vector<std::size_t> suspect_frames;  ///< frame indices whose pose is doubtful (FrameResult::suspect)
   double mean_frame_seconds = 0.0;
   Trajectory trajectory;

@@ -103,6 +103,24 @@ std::string pose_sigma_words(const Mat6& covariance) {
   return text;
 }
 
+std::string last_pose_note(const Mat6& covariance, std::size_t lost_at_end) {
+  const std::string sigma = "last pose 1-sigma " + pose_sigma_words(covariance);
+  if (lost_at_end == 0) return sigma + " (grown from 0 at the first frame; every frame's in pose_covariance.txt)";
+  return sigma + ": a prediction, not an estimate (the last " + std::to_string(lost_at_end) +
+         " frame(s) were lost and each adds the prediction's doubt; every frame's in pose_covariance.txt)";
+}
+
+std::string map_restart_warning(const std::vector<std::size_t>& frames, std::size_t lost_before) {
+  if (frames.empty()) return {};
+  std::string text = "warning: the local map was started again at frame";
+  text += frames.size() == 1 ? " " : "s ";
+  for (std::size_t i = 0; i < frames.size(); ++i) text += (i > 0 ? ", " : "") + std::to_string(frames[i]);
+  return text + ", after " + std::to_string(lost_before) +
+         " failed registrations in a row (odometry.restart_after_lost): the trajectory after each restart is measured "
+         "again, but joins the one before through the motion prediction alone, so the offset there is unknown "
+         "(metrics.json map_restarts)\n";
+}
+
 void add_pose_covariance_traces(nlohmann::json& metrics, const std::vector<io::StampedCovariance>& covariances) {
   nlohmann::json& per_frame = metrics["per_frame"];
   for (std::size_t k = 0; k < covariances.size() && k < per_frame.size(); ++k)
@@ -192,6 +210,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
                          {"weak_translation_base", weak},
                          {"weak_direction", weak_words},
                          {"lost", f.lost()},
+                         {"map_restarted", f.map_restarted},
                          {"suspect", f.suspect()},
                          {"trust", slam::trust_name(f.trust)},
                          {"recent_residual_m", std::isfinite(f.recent_residual_m) ? nlohmann::json(f.recent_residual_m) : nlohmann::json()},
@@ -216,6 +235,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["degenerate_directions"] = degenerate_directions;
   json["retried_frames"] = retried;
   json["lost_frames"] = lost;
+  json["map_restarts"] = map_restart_frames(frames, [](const slam::FrameResult& f) { return f.map_restarted; });
   json["suspect_frames"] = suspect;
   json["front_end"] = front_end_summary(names, frames);
   json["per_frame"] = std::move(per_frame);

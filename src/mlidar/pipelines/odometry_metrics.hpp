@@ -25,6 +25,20 @@ std::vector<io::StampedCovariance> pose_covariances(const std::vector<slam::Fram
 /// "x 0.012 m, y 0.015 m, z 0.018 m, rotation 0.04 deg": the 1-sigmas of a pose covariance (pose_covariance.txt's
 /// tangent; rotation: the largest axis).
 std::string pose_sigma_words(const Mat6& covariance);
+/// The terminal's note on the last pose's 1-sigma; after `lost_at_end` lost frames in a row it says the pose is a
+/// prediction whose doubt grew with each (so tens of metres after a long run of them are no estimate).
+std::string last_pose_note(const Mat6& covariance, std::size_t lost_at_end);
+
+/// metrics.json `map_restarts`: the indices of the frames that started a new local map (slam::FrameResult::map_restarted).
+template <typename Frame, typename Restarted>
+std::vector<std::size_t> map_restart_frames(const std::vector<Frame>& frames, Restarted restarted) {
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < frames.size(); ++k)
+    if (restarted(frames[k])) out.push_back(k);
+  return out;
+}
+/// The terminal's warning on frames that started a new local map; empty for none.
+std::string map_restart_warning(const std::vector<std::size_t>& frames, std::size_t lost_before);
 
 /// metrics.json per frame: `pose_covariance_trace` (m^2 + rad^2) from `covariances` (one per frame).
 void add_pose_covariance_traces(nlohmann::json& metrics, const std::vector<io::StampedCovariance>& covariances);

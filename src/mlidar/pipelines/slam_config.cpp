@@ -152,12 +152,16 @@ std::vector<Field> shock_fields(SlamConfig& c) {
 
 std::vector<Field> extrinsic_check_fields(SlamConfig& c) {
   return {
-      {"extrinsic_check", "frames", {1, 1e5}, "frames in the median residual ratio of a given extrinsic", &c.extrinsic_check.frames},
+      {"extrinsic_check",
+       "frames",
+       {1, 1e5},
+       "frames in the median residual ratio of a given extrinsic",
+       &c.extrinsic_check.residual.frames},
       {"extrinsic_check",
        "residual_ratio",
        {0.0, 100.0},
        "median ratio of a LiDAR's residual to the base's above which its given extrinsic disagrees with the map (0: no check)",
-       &c.extrinsic_check.residual_ratio},
+       &c.extrinsic_check.residual.residual_ratio},
       {"extrinsic_check",
        "map_first_frames",
        {0, 1e5},
@@ -169,7 +173,11 @@ std::vector<Field> extrinsic_check_fields(SlamConfig& c) {
        {1.0, 1000.0},
        "a LiDAR's points this many times farther from the others' planes than from its own disagree",
        &c.extrinsic_check.map_ratio},
-      {"extrinsic_check", "recalibrate", {}, "calibrate a disagreeing extrinsic online from it (else report only)", &c.recalibrate_disagreeing},
+      {"extrinsic_check",
+       "recalibrate",
+       {},
+       "calibrate a disagreeing extrinsic online from it (else report only)",
+       &c.extrinsic_check.recalibrate},
   };
 }
 
@@ -180,6 +188,11 @@ std::vector<Field> odometry_fields(SlamConfig& c) {
       {"odometry", "edge_voxel_m", {0.0, 100.0, true, false}, "voxel size of the local edge map", &odo.edge_voxel_m},
       {"odometry", "local_map_radius_m", {0.0, 1e4, true, false}, "voxels farther are dropped", &odo.local_map_radius_m},
       {"odometry", "max_iterations", {1, 1000}, "registration iterations per frame", &odo.registration.max_iterations},
+      {"odometry",
+       "restart_after_lost",
+       {0, 1e6},
+       "frames lost in a row after which the next frame with points starts a new local map at its predicted pose (0: never)",
+       &odo.restart_after_lost},
       {"odometry",
        "refine_deskew",
        {},

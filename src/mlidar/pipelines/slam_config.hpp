@@ -51,6 +51,20 @@ struct MappingParams {
   double extrinsic_prior_rotation_deg = 0.04;
 };
 
+/// Given extrinsics (`slam --calibrate fixed`, `odometry`) judged against the map: the `extrinsic_check:` section.
+struct GivenExtrinsicChecks {
+  /// Each auxiliary LiDAR's residual over the base's (calib/extrinsic_check.hpp); residual_ratio 0 turns every check off.
+  calib::ExtrinsicCheckConfig residual;
+  /// The map test (slam/map_consistency.hpp) after this many frames and again at twice as many each time (30, 60,
+  /// 120, ...; 0: never; the odometry job: on its final map): a LiDAR's points map_ratio times farther from the other
+  /// LiDARs' planes than from its own disagree. Doubling keeps its cost (about 50 ms for 4 LiDARs) off long runs.
+  std::size_t map_first_frames = 30;
+  double map_ratio = 3.0;
+  /// A given extrinsic that disagrees is calibrated online from it, as `--calibrate refine` does (else only reported).
+  bool recalibrate = true;
+  bool enabled() const { return residual.residual_ratio > 0.0; }
+};
+
 struct SlamConfig {
   /// Eq 4.15-4.18; measured defaults beyond the thesis: the translation's predicted std gate and the planar start.
   calib::OnlineHandEyeConfig initialization{.translation_max_std_m = 0.1, .planar_rotation = true, .planar_min_pairs = 30};
@@ -63,10 +77,7 @@ struct SlamConfig {
   /// Re-calibration trigger; a rise below 2x is not a shock: a sustained 1.45-1.76x rise of one LiDAR's residual
   /// ratio in part of the simulated room fired a false trigger (43 m protocol, room seed 6), Table 4.6's shock is 6x.
   calib::ShockDetectorConfig shock{.min_relative_jump = 1.0};
-  /// Given extrinsics (`--calibrate fixed`) judged against the map (calib/extrinsic_check.hpp).
-  calib::ExtrinsicCheckConfig extrinsic_check;
-  /// A given extrinsic that disagrees is calibrated online from it, as `--calibrate refine` does (else only reported).
-  bool recalibrate_disagreeing = true;
+  GivenExtrinsicChecks extrinsic_check;
   slam::OdometryConfig odometry;  ///< front end and scan-to-map registration; odometry.uncertainty is `mapping:`
   MappingParams mapping;
 };

@@ -32,7 +32,7 @@ SlamEstimator::SlamEstimator(SlamConfig config, std::vector<slam::LidarSetup> li
     : config_(std::move(config)),
       source_(source),
       shock_(lidars.size(), config_.shock),
-      extrinsic_check_(lidars.size(), config_.extrinsic_check),
+      extrinsic_check_(lidars.size(), config_.extrinsic_check.residual),
       history_(config_.start.appearance_after_frames + 1, static_cast<std::size_t>(std::max(config_.appearance.refine.frame_step, 1))) {
   if (lidars.empty()) throw std::invalid_argument("SlamEstimator: no LiDARs");
   tracks_.reserve(lidars.size());  // the tracks refer to config_, never moved after this
@@ -126,8 +126,7 @@ void SlamEstimator::check_given_extrinsics(SlamFrame& out) {
   for (std::size_t j = 1; j < tracks_.size(); ++j)
     if (given[j]) out.lidars[j].residual_ratio = extrinsic_check_.median_ratio(j).value_or(-1.0);
   // Nothing registered yet with two or more LiDARs: the residuals say nothing, and any given one may be the cause.
-  const bool lost_from_start =
-      config_.extrinsic_check.residual_ratio > 0.0 && lost_from_start_ == kLostFromStartFrames && trusted_.size() > 1;
+  const bool lost_from_start = config_.extrinsic_check.enabled() && lost_from_start_ == kLostFromStartFrames && trusted_.size() > 1;
   if (lost_from_start) {
     disagreeing.clear();
     for (std::size_t j = 1; j < tracks_.size(); ++j)
@@ -141,8 +140,8 @@ void SlamEstimator::check_given_extrinsics(SlamFrame& out) {
                                              .map_ratio = by_map ? out.lidars[j].map_ratio : -1.0,
                                              .frames_lost = lost_from_start,
                                              .after_shock = shock_.lidar(j).triggers > 0};
-    tracks_[j].given_disagrees(disagreement, config_.recalibrate_disagreeing);
-    if (!config_.recalibrate_disagreeing) continue;
+    tracks_[j].given_disagrees(disagreement, config_.extrinsic_check.recalibrate);
+    if (!config_.extrinsic_check.recalibrate) continue;
     extrinsic_check_.reset(j);
     trusted_changed_ = true;
   }
@@ -152,8 +151,7 @@ std::vector<std::size_t> SlamEstimator::map_disagreements(const std::vector<bool
   const std::size_t first = config_.extrinsic_check.map_first_frames;
   std::vector<std::size_t> found;
   const bool due = first > 0 && frames_ % first == 0 && std::has_single_bit(frames_ / first);  // first * 2^n frames
-  if (!due || config_.extrinsic_check.residual_ratio == 0.0 || trusted_set_changed_ ||
-      std::find(given.begin(), given.end(), true) == given.end())
+  if (!due || !config_.extrinsic_check.enabled() || trusted_set_changed_ || std::find(given.begin(), given.end(), true) == given.end())
     return found;
   // The map's sources are the trusted odometry's LiDAR indices: trusted_[i] is LiDAR i's track.
   const std::vector<slam::SourceConsistency> consistency = slam::map_consistency(odometry_->plane_map(), trusted_.size());
@@ -179,6 +177,7 @@ SlamFrame SlamEstimator::process(double stamp, const std::vector<std::optional<S
   odometry_->set_selection_paused(calibrating && !odometry_->config().registration.selection.while_calibrating);
   last_odometry_ = odometry_->process(trusted_frame(stamp, scans, trusted_));
   out.lost = last_odometry_.lost();
+  out.map_restarted = last_odometry_.map_restarted;
   if (k > 0 && !registered_once_) {
     registered_once_ = !out.lost;
     lost_from_start_ = out.lost ? lost_from_start_ + 1 : 0;

@@ -167,6 +167,7 @@ SlamJobSummary summarize(const SlamRun& run, const SlamEstimator& estimator, con
                          const SlamJob& job, const BaseFrame& frame) {
   SlamJobSummary summary;
   summary.frames = run.frames.size();
+  summary.restart_after_lost = estimator.trusted_odometry().config().restart_after_lost;
   summary.trajectory = final_trajectory(run, frame);
   summary.gaps = gaps.summary_lines();
   summary.base_failure = gaps.base_failure(job.max_base_gaps, frame.reference);
@@ -176,6 +177,8 @@ SlamJobSummary summarize(const SlamRun& run, const SlamEstimator& estimator, con
   for (std::size_t k = 0; k < run.frames.size(); ++k) {
     const auto& f = run.frames[k];
     summary.lost_frames += f.lost ? 1 : 0;
+    summary.lost_at_end = f.lost ? summary.lost_at_end + 1 : 0;
+    if (f.map_restarted) summary.map_restarts.push_back(k);
     if (f.suspect) summary.suspect_frames.push_back(k);
     const auto& s = f.seconds;
     summary.mean_frame_seconds +=
@@ -217,7 +220,7 @@ SlamJobSummary run_slam_job(const SlamJob& job, const std::function<void(int, in
   do {
     estimator = std::make_unique<SlamEstimator>(config, estimator_setups(source, order, frame, given, config), job.calibrate, disagreed);
     gaps = std::make_unique<FrameGaps>(source);
-    run = run_frames(source, order, *estimator, *gaps, config.recalibrate_disagreeing, progress);
+    run = run_frames(source, order, *estimator, *gaps, config.extrinsic_check.recalibrate, progress);
     for (std::size_t j = 1; j < order.size(); ++j)
       if (calibrate_from_the_start(*estimator, j)) disagreed[j] = estimator->track(j).disagreement();
   } while (run.stopped_at_disagreement);

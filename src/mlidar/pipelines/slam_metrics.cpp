@@ -182,6 +182,7 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
     per_frame.push_back({{"stamp", f.stamp},
                          {"mode", f.calibrating ? "calibration" : "odometry"},
                          {"lost", f.lost},
+                         {"map_restarted", f.map_restarted},
                          {"suspect", f.suspect},
                          {"trusted_changed", f.trusted_changed},
                          {"lidars", per_lidar},
@@ -196,6 +197,7 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
                            {"window", f.seconds.window}}}});
   }
   json["lost_frames"] = lost;
+  json["map_restarts"] = map_restart_frames(frames, [](const SlamFrame& f) { return f.map_restarted; });
   json["suspect_frames"] = suspect;
   json["trusted_set_changes"] = changes;
   json["calibration_frames"] = calibrating;

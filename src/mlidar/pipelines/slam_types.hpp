@@ -68,6 +68,7 @@ struct SlamFrame {
   std::optional<slam::WindowPose> settled;  ///< window.refine_odometry: an earlier frame's final pose
   bool calibrating = false;                 ///< some LiDAR not trusted after this frame (online-calibration mode), else pure odometry
   bool lost = false;                        ///< the trusted odometry could not register this frame
+  bool map_restarted = false;               ///< ... and started a new local map with it (slam::FrameResult::map_restarted)
   bool suspect = false;                     ///< its registration was doubtful (slam::FrameResult::suspect)
   /// The trusted odometry's pose covariance (slam/pose_covariance.hpp; left perturbation, world frame).
   Mat6 pose_covariance = Mat6::Zero();

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "mlidar/calib/extrinsic_check.hpp"
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/eval/calibration_metrics.hpp"
 #include "mlidar/report/report_sections.hpp"
@@ -19,14 +20,27 @@ std::string joined(const nlohmann::json& strings, const std::string& separator) 
   std::string out;
   if (!strings.is_array()) return out;
   for (const auto& s : strings) {
-    if (!s.is_string()) continue;
+    if (!s.is_string() && !s.is_number_integer()) continue;
     if (!out.empty()) out += separator;
-    out += s.get<std::string>();
+    out += s.is_string() ? s.get<std::string>() : std::to_string(s.get<long long>());
   }
   return out;
 }
 
 std::string frame_text(const nlohmann::json& frame) { return frame.is_number() ? std::to_string(frame.get<long long>()) : "-"; }
+
+/// A given extrinsic's disagreement as metrics.json records it (slam's per_lidar.NAME.extrinsic_check, odometry's
+/// extrinsic_check entries).
+calib::DisagreementEvidence evidence_of(const nlohmann::json& check) {
+  const nlohmann::json frame = check.value("disagreed_frame", nlohmann::json());
+  calib::DisagreementEvidence evidence{.frame = frame.is_number_unsigned() ? frame.get<std::size_t>() : 0,
+                                       .residual_ratio = number_of(check.value("residual_ratio", nlohmann::json())),
+                                       .map_ratio = number_of(check.value("map_ratio", nlohmann::json())),
+                                       .frames_lost = check.value("frames_lost", false)};
+  const nlohmann::json compared_with = check.value("compared_with", nlohmann::json());
+  if (compared_with.is_string()) evidence.reference = compared_with.get<std::string>();
+  return evidence;
+}
 
 /// slam: one verdict per LiDAR of metrics.per_lidar, then the frames.
 void slam_verdicts(const RunData& run, std::vector<Verdict>& out) {
@@ -37,14 +51,7 @@ void slam_verdicts(const RunData& run, std::vector<Verdict>& out) {
       if (name == base) continue;
       const nlohmann::json check = lidar.value("extrinsic_check", nlohmann::json());
       if (check.is_object())
-        out.push_back({"bad", name + ": the given extrinsic disagrees with the map (" +
-                                  (check.value("frames_lost", false) ? "no frame could be registered with the given extrinsics; "
-                                   : number_of(check.value("map_ratio", nlohmann::json())) > 0.0
-                                       ? "at frame " + frame_text(check.value("disagreed_frame", nlohmann::json())) +
-                                             " its points lay " + fixed(number_of(check["map_ratio"]), 1) +
-                                             "x farther from the other LiDARs' surfaces than from its own); "
-                                       : "from frame " + frame_text(check.value("disagreed_frame", nlohmann::json())) + " its residual was " +
-                                             fixed(number_of(check.value("residual_ratio", nlohmann::json())), 1) + "x the base's); ") +
+        out.push_back({"bad", name + ": the given extrinsic disagrees with the map (" + calib::describe(evidence_of(check)) + "); " +
                                   (check.value("recalibrated", false) ? "calibrated online from it: see extrinsics.yaml and fix the input"
                                                                       : "used as given: the trajectory and map may be wrong")});
       const nlohmann::json converged = lidar.value("converged_frame", nlohmann::json());
@@ -74,14 +81,14 @@ void frame_verdicts(const nlohmann::json& metrics, std::vector<Verdict>& out) {
   };
   if (count("lost_frames") > 0)
     out.push_back({"bad", std::to_string(count("lost_frames")) + " frame(s) could not be registered (lost): their poses are predictions"});
+  if (metrics.contains("map_restarts") && metrics["map_restarts"].is_array() && !metrics["map_restarts"].empty())
+    out.push_back({"bad", "the local map was started again at frame(s) " + joined(metrics["map_restarts"], ", ") +
+                              " after registrations failed in a row: each part of the trajectory is measured, but the offset "
+                              "between them is the motion prediction's"});
   if (metrics.contains("extrinsic_check") && metrics["extrinsic_check"].is_array())  // odometry's (slam's: per LiDAR)
     for (const auto& d : metrics["extrinsic_check"])
       out.push_back({"bad", d.value("lidar", std::string("?")) + ": the given extrinsic disagrees with the map (" +
-                                (number_of(d.value("map_ratio", nlohmann::json())) > 0.0
-                                     ? "its points lay " + fixed(number_of(d["map_ratio"]), 1) +
-                                           "x farther from the other LiDARs' surfaces than from its own"
-                                     : "from frame " + frame_text(d.value("disagreed_frame", nlohmann::json())) + " its residual was " +
-                                           fixed(number_of(d.value("residual_ratio", nlohmann::json())), 1) + "x the base's") +
+                                calib::describe(evidence_of(d)) +
                                 "): the trajectory and map may be wrong; calibrate it with `mlidar slam --calibrate refine`"});
   if (count("suspect_frames") > 0)
     out.push_back({"warn", std::to_string(count("suspect_frames")) + " frame(s) suspect: registered but not trusted, left out of the map"});

@@ -276,9 +276,11 @@ std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, c
 
 void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_unmapped) {
   const BodyVelocity velocity = latest_velocity();
-  // World so far: the base at the first centroid, whose pose from the first stamp is Exp(t_c v).
+  // World so far: the base at the first centroid (at T_world_origin_), whose pose from the first stamp is Exp(t_c v):
+  // the first stamp's pose becomes T_world_origin_.
   const SE3 T_stamp_centroid = velocity.pose_at(first_centroid_time);
-  for (auto& pose : centroid_poses_) pose.T_world_base = T_stamp_centroid * pose.T_world_base;
+  const SE3 shift = T_world_origin_ * T_stamp_centroid * T_world_origin_.inverse();
+  for (auto& pose : centroid_poses_) pose.T_world_base = shift * pose.T_world_base;
   edge_map_ = VoxelMap(config_.edge_voxel_m, config_.edge_points_per_voxel);
   plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);
   // The first frame defines the world (no pose doubt); the second is registered against it alone, its
@@ -328,7 +330,10 @@ double Odometry::voxel_sample_share() const {
 double Odometry::residual_scale() const { return 1.0 + (config_.trust.voxel_residual_ratio - 1.0) * voxel_sample_share(); }
 
 TrustRule Odometry::trust_rule() const {
-  return {config_.trust, residual_scale() * recent_residuals_.median_m(), centroid_poses_.size() == 1};
+  // The second frame of a map (at the run's start or after start_over) matches the first sweep alone.
+  const double recent_median_m = recent_residuals_.size() >= config_.trust.min_residual_history ? recent_residuals_.median_m()
+                                                                                                : std::numeric_limits<double>::quiet_NaN();
+  return {config_.trust, residual_scale() * recent_median_m, centroid_poses_.size() == 1};
 }
 
 void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
@@ -519,10 +524,12 @@ FrameResult Odometry::process(const Frame& frame) {
   result.stamp = frame.stamp;
   result.centroid_time = mean_point_time(frame);
   const double centroid_stamp = frame.stamp + result.centroid_time;
+  if (restart_due(frame)) {
+    start_over(predicted_centroid_pose(centroid_stamp));
+    result.map_restarted = true;
+  }
   const BodyVelocity velocity = latest_velocity();
-  const SE3 prediction = centroid_poses_.empty()
-                             ? SE3::identity()
-                             : centroid_poses_.back().T_world_base * velocity.pose_at(centroid_stamp - centroid_poses_.back().stamp);
+  const SE3 prediction = predicted_centroid_pose(centroid_stamp);
 
   std::vector<StageSeconds> per_lidar(lidars_.size(), StageSeconds{});
   tbb::parallel_for(std::size_t{0}, lidars_.size(), [&](std::size_t i) {
@@ -538,6 +545,7 @@ FrameResult Odometry::process(const Frame& frame) {
   SE3 T_world_centroid = SE3::identity();
   if (centroid_poses_.empty()) {
     result.registration.converged = true;
+    T_world_centroid = T_world_origin_;
   } else {
     std::optional<MotionDeskew> motion;
     if (config_.deskew_in_registration && centroid_poses_.size() >= 2 && centroid_stamp > centroid_poses_.back().stamp)
@@ -566,13 +574,13 @@ FrameResult Odometry::process(const Frame& frame) {
     first_features_ = frame_features_;
     first_blocks_ = frame_blocks_;
   }
-  centroid_poses_.push_back({centroid_stamp, T_world_centroid});
-  if (centroid_poses_.size() == 2) {
+  push_centroid_pose({centroid_stamp, T_world_centroid});
+  if (segment_frames_ == 2) {
     restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.flagged());
     result.registration.T_world_base = centroid_poses_.back().T_world_base;
   } else if (result.trust == Trust::kTrusted) {
     // The first frame defines the world: no pose doubt.
-    const bool registered = centroid_poses_.size() > 1;
+    const bool registered = segment_frames_ > 1;
     const Mat6 Xi_reg =
         config_.uncertainty.enabled && registered ? registration_covariance(result.registration, MotionPriorSigma{}) : Mat6::Zero();
     result.mapping = update_map(T_world_centroid, frame_features_, frame_blocks_, Xi_reg);
@@ -582,7 +590,46 @@ FrameResult Odometry::process(const Frame& frame) {
   if (centroid_poses_.size() >= 2 && !result.lost()) recent_residuals_.add(result.registration.mean_residual_m / residual_scale());
   result.seconds[static_cast<std::size_t>(Stage::kMapUpdate)] += seconds_since(start);
   result.T_world_base = centroid_poses_.back().T_world_base * latest_velocity().pose_at(-result.centroid_time);
+  if (result.map_restarted) {
+    result.trust = Trust::kLost;  // mapped as the new map's first frame, its pose a prediction
+  } else if (!result.lost()) {
+    lost_in_a_row_ = 0;
+  } else if (result.edge_features + result.plane_features > 0) {
+    ++lost_in_a_row_;  // a registration that failed (a frame without features, e.g. a gap in the input, is no evidence)
+    failed_on_voxel_samples_ = mostly_voxel_samples();
+  }
   return result;
+}
+
+SE3 Odometry::predicted_centroid_pose(double centroid_stamp) const {
+  if (centroid_poses_.empty()) return T_world_origin_;
+  return centroid_poses_.back().T_world_base * latest_velocity().pose_at(centroid_stamp - centroid_poses_.back().stamp);
+}
+
+bool Odometry::restart_due(const Frame& frame) const {
+  if (config_.restart_after_lost == 0 || lost_in_a_row_ < config_.restart_after_lost) return false;
+  if (failed_on_voxel_samples_) return false;  // keyframes without scan rows do not restart
+  return std::any_of(frame.scans.begin(), frame.scans.end(), [](const Scan& scan) { return !scan.empty(); });
+}
+
+void Odometry::push_centroid_pose(const StampedPose& pose) {
+  // The velocity needs the last two; the second frame of a map also the first.
+  if (centroid_poses_.size() == 2) centroid_poses_.erase(centroid_poses_.begin());
+  centroid_poses_.push_back(pose);
+  ++segment_frames_;
+}
+
+void Odometry::start_over(const SE3& T_world_origin) {
+  T_world_origin_ = T_world_origin;
+  centroid_poses_.clear();
+  segment_frames_ = 0;
+  edge_map_ = VoxelMap(config_.edge_voxel_m, config_.edge_points_per_voxel);
+  plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);
+  degeneracy_stamp_ = -std::numeric_limits<double>::infinity();
+  degenerate_scene_ = false;
+  error_sq_sum_ = 0.0;
+  error_count_ = 0;
+  lost_in_a_row_ = 0;
 }
 
 }  // namespace mlidar::slam

@@ -101,6 +101,16 @@ struct OdometryConfig {
   /// Frames this long after the previous one (seconds) always run the retries
   /// and are judged with their rivals, trusted first registration or not.
   double always_retry_after_s = 1.5;
+  /// After this many frames in a row whose registration failed (lost with features; frames without any, a gap in
+  /// the input, are not counted), the next frame with points starts a new local map at its predicted pose (0: never):
+  /// registered against a map it has left or from a prediction that went wrong (a velocity never known, a gap while
+  /// turning), every later frame would be lost too. The restart frame is itself lost (its pose is the prediction,
+  /// FrameResult::map_restarted); the frames after it are registered against the new map, so their relative motion
+  /// is measured again while the offset to the trajectory before is the prediction's. Frames of voxel samples
+  /// (clouds without scan rows: ring-less keyframes, solid-state scanners) never restart: on simulated solid-state
+  /// keyframes 0.1-7 s apart, maps started again from one sparse keyframe let 1 wrong pair of 290 pass as trusted
+  /// (docs/benchmarks.md "Frames lost in a row start a new map").
+  std::size_t restart_after_lost = 5;
   /// After a trusted registration, deskew the frame's features again with the
   /// velocity it measured (the prediction's is a frame late) and register once
   /// more from there, before they enter the map. Off: it costs a second
@@ -149,8 +159,11 @@ struct FrameResult {
   bool retried = false;
   Trust trust = Trust::kTrusted;
   double recent_residual_m = 0.0;  ///< the recent frames' median mean |r| it was judged against (NaN: none)
-  /// No acceptable registration: the pose is the prediction, not mapped.
+  /// No acceptable registration: the pose is the prediction, not mapped (except by a map_restarted frame).
   bool lost() const { return trust == Trust::kLost; }
+  /// This frame started a new local map at its predicted pose after OdometryConfig::restart_after_lost frames lost
+  /// in a row (it is lost: the trajectory after it joins the one before through the prediction alone).
+  bool map_restarted = false;
   /// Acceptable but not trusted (`trust` says why): the pose is kept, not mapped.
   bool suspect() const { return trust == Trust::kResidual || trust == Trust::kAmbiguous || trust == Trust::kDegenerate; }
   /// Lost or suspect: its pose must not feed a calibration, a window or a map.
@@ -245,6 +258,16 @@ class Odometry {
   /// first frame's centroid pose to its stamp pose and rebuilds the map from
   /// the first two frames' features deskewed with that velocity.
   void restart_with_first_velocity(double first_centroid_time, bool second_unmapped);
+  /// A new local map from the next frame on, as at the start but with its first pose T_world_origin: the maps, the
+  /// pose history, the velocity and the threshold's history are forgotten; the recent residuals (the scene's fit)
+  /// are kept.
+  void start_over(const SE3& T_world_origin);
+  /// OdometryConfig::restart_after_lost failed registrations in a row (not of voxel samples), and this frame has points.
+  bool restart_due(const Frame& frame) const;
+  /// The constant-velocity prediction of the base at a centroid stamp (T_world_origin_ before any frame).
+  SE3 predicted_centroid_pose(double centroid_stamp) const;
+  /// Keeps the last two centroid poses (the velocity's) and counts the map's frames.
+  void push_centroid_pose(const StampedPose& pose);
 
   OdometryConfig config_;
   std::vector<LidarSetup> lidars_;
@@ -257,7 +280,11 @@ class Odometry {
   std::optional<QueryCovariances> query_covariances_;
   VoxelMap edge_map_;
   VoxelMap plane_map_;
-  std::vector<StampedPose> centroid_poses_;  ///< T_world_base at each frame's time centroid
+  std::vector<StampedPose> centroid_poses_;  ///< T_world_base at the last two frames' time centroids
+  std::size_t segment_frames_ = 0;           ///< frames since the start (or the last start_over)
+  SE3 T_world_origin_;                       ///< the first frame's centroid pose (identity; after start_over, a prediction)
+  std::size_t lost_in_a_row_ = 0;            ///< frames with features lost since the last one registered
+  bool failed_on_voxel_samples_ = false;     ///< the last failed registration's frame was mostly voxel samples
   /// Mean |r| of the last registered (not lost) frames, each divided by its
   /// frame's residual_scale().
   ResidualHistory recent_residuals_;

@@ -46,7 +46,7 @@ bool TrustRule::acceptable(const RegistrationResult& r) const {
 }
 
 double TrustRule::trusted_limit_m() const {
-  if (!std::isfinite(recent_median_m)) return std::numeric_limits<double>::infinity();
+  if (!std::isfinite(recent_median_m)) return config.history_free_max_residual_m;
   return std::max(config.residual_floor_m, config.residual_ratio * recent_median_m);
 }
 

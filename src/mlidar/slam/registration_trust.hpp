@@ -34,6 +34,12 @@ struct TrustConfig {
   double residual_ratio = 2.0;        ///< trusted: mean |r| at most this x the recent median ...
   double residual_floor_m = 0.03;     ///< ... or at most this, whichever is larger
   std::size_t residual_history = 10;  ///< registered frames the recent median is taken over
+  /// Until the history holds this many, there is no recent median to judge by, and a registration is trusted only
+  /// up to history_free_max_residual_m (else suspect): without it any acceptable fit was trusted. One RS-LiDAR-16 at
+  /// 7.5 m/s whose first 0.8 s of scans were missing registered its next frame 1.8 m off at mean |r| 0.19 m, trusted
+  /// (right second frames: 0.015-0.03 m on the simulated rigs; docs/benchmarks.md "Frames lost in a row").
+  std::size_t min_residual_history = 3;
+  double history_free_max_residual_m = 0.06;
   /// Voxel samples (the front end's fallback) fit this much looser than
   /// range-image features of the same scene when the map holds both (real
   /// BALM keyframe 21: 0.031 m for its voxel samples alone, about 0.024 m for
@@ -71,6 +77,7 @@ class ResidualHistory {
   void add(double mean_residual_m);
   /// NaN before the first.
   double median_m() const;
+  std::size_t size() const { return values_.size(); }
 
  private:
   std::size_t capacity_;
@@ -79,12 +86,12 @@ class ResidualHistory {
 
 struct TrustRule {
   TrustConfig config;
-  double recent_median_m;  ///< NaN: no history yet (then acceptable is trusted)
+  double recent_median_m;        ///< NaN: no history yet (then trusted up to history_free_max_residual_m)
   bool first_sweep_map = false;  ///< the map holds the first frame alone (TrustConfig::first_match_ratio)
 
   bool acceptable(const RegistrationResult& r) const;
   bool trusted(const RegistrationResult& r) const;
-  /// The largest mean |r| a trusted registration may have (infinite without history).
+  /// The largest mean |r| a trusted registration may have (history_free_max_residual_m without history).
   double trusted_limit_m() const;
 };
 
