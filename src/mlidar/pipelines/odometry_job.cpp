@@ -97,7 +97,6 @@ constexpr std::size_t kMapTestPlanes = 100;
 
 /// Each LiDAR's given extrinsic but lidars[base]'s judged against the map over the frames' residuals
 /// (calib::ExtrinsicCheck; lost frames left out).
-
 std::vector<GivenExtrinsicDisagreement> check_given_extrinsics(const std::vector<slam::FrameResult>& results,
                                                                const std::vector<slam::LidarSetup>& lidars, std::size_t base,
                                                                const std::string& compared_with,

@@ -177,6 +177,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["lidars"] = names;
   std::vector<double> total, points_in, features_out;
   std::size_t degenerate = 0, retried = 0, lost = 0, suspect = 0;
+  std::vector<std::size_t> map_restarts;  // frames that started a new local map
   for (std::size_t s = 0; s < slam::kStageCount; ++s) {
     std::vector<double> stage;
     for (const auto& f : frames) stage.push_back(f.seconds[s]);
@@ -201,6 +202,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
     degenerate += f.registration.degenerate ? 1 : 0;
     retried += f.retried ? 1 : 0;
     lost += f.lost() ? 1 : 0;
+    if (f.map_restarted) map_restarts.push_back(per_frame.size());
     suspect += f.suspect() ? 1 : 0;
     const auto& r = f.registration;
     per_frame.push_back({{"stamp", f.stamp},
@@ -235,7 +237,7 @@ nlohmann::json odometry_metrics_json(const std::vector<slam::FrameResult>& frame
   json["degenerate_directions"] = degenerate_directions;
   json["retried_frames"] = retried;
   json["lost_frames"] = lost;
-  json["map_restarts"] = map_restart_frames(frames, [](const slam::FrameResult& f) { return f.map_restarted; });
+  json["map_restarts"] = map_restarts;
   json["suspect_frames"] = suspect;
   json["front_end"] = front_end_summary(names, frames);
   json["per_frame"] = std::move(per_frame);

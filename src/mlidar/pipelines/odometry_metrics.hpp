@@ -29,14 +29,6 @@ std::string pose_sigma_words(const Mat6& covariance);
 /// prediction whose doubt grew with each (so tens of metres after a long run of them are no estimate).
 std::string last_pose_note(const Mat6& covariance, std::size_t lost_at_end);
 
-/// metrics.json `map_restarts`: the indices of the frames that started a new local map (slam::FrameResult::map_restarted).
-template <typename Frame, typename Restarted>
-std::vector<std::size_t> map_restart_frames(const std::vector<Frame>& frames, Restarted restarted) {
-  std::vector<std::size_t> out;
-  for (std::size_t k = 0; k < frames.size(); ++k)
-    if (restarted(frames[k])) out.push_back(k);
-  return out;
-}
 /// The terminal's warning on frames that started a new local map; empty for none.
 std::string map_restart_warning(const std::vector<std::size_t>& frames, std::size_t lost_before);
 

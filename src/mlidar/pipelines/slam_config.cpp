@@ -191,7 +191,8 @@ std::vector<Field> odometry_fields(SlamConfig& c) {
       {"odometry",
        "restart_after_lost",
        {0, 1e6},
-       "frames lost in a row after which the next frame with points starts a new local map at its predicted pose (0: never)",
+       "failed registrations in a row (frames without points not counted) after which the next frame with points starts a "
+       "new local map at its predicted pose (0: never)",
        &odo.restart_after_lost},
       {"odometry",
        "refine_deskew",

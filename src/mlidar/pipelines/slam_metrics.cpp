@@ -170,10 +170,12 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
   json["stages"] = stage_timings(frames, load_seconds, total);
   json["total_seconds"] = total;
   std::size_t lost = 0, suspect = 0, changes = 0, calibrating = 0;
+  std::vector<std::size_t> map_restarts;  // frames that started a new local map
   nlohmann::json per_frame = nlohmann::json::array();
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const SlamFrame& f = frames[i];
     lost += f.lost ? 1 : 0;
+    if (f.map_restarted) map_restarts.push_back(i);
     suspect += f.suspect ? 1 : 0;
     changes += f.trusted_changed ? 1 : 0;
     calibrating += f.calibrating ? 1 : 0;
@@ -197,7 +199,7 @@ nlohmann::json slam_metrics_json(const std::vector<SlamFrame>& frames, const std
                            {"window", f.seconds.window}}}});
   }
   json["lost_frames"] = lost;
-  json["map_restarts"] = map_restart_frames(frames, [](const SlamFrame& f) { return f.map_restarted; });
+  json["map_restarts"] = map_restarts;
   json["suspect_frames"] = suspect;
   json["trusted_set_changes"] = changes;
   json["calibration_frames"] = calibrating;

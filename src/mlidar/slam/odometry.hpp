@@ -109,7 +109,7 @@ struct OdometryConfig {
   /// is measured again while the offset to the trajectory before is the prediction's. Frames of voxel samples
   /// (clouds without scan rows: ring-less keyframes, solid-state scanners) never restart: on simulated solid-state
   /// keyframes 0.1-7 s apart, maps started again from one sparse keyframe let 1 wrong pair of 290 pass as trusted
-  /// (docs/benchmarks.md "Frames lost in a row start a new map").
+  /// (docs/benchmarks.md "Failed registrations in a row start a new local map").
   std::size_t restart_after_lost = 5;
   /// After a trusted registration, deskew the frame's features again with the
   /// velocity it measured (the prediction's is a frame late) and register once
