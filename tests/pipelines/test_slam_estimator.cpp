@@ -165,8 +165,9 @@ TEST(SlamEstimator, FeatureSelectionWaitsUntilEveryLidarIsTrusted) {
       EXPECT_EQ(frames[k].lidars[1].role, plain.lidars[1].role) << "frame " << k;  // trusted at the same frame
       // The calibration windows start from the hand-eye on the right LiDAR's own odometry: the same estimates.
       ASSERT_EQ(frames[k].lidars[1].window_estimate.has_value(), plain.lidars[1].window_estimate.has_value()) << "frame " << k;
-      if (plain.lidars[1].window_estimate)
+      if (plain.lidars[1].window_estimate) {
         EXPECT_EQ(frames[k].lidars[1].window_estimate->matrix(), plain.lidars[1].window_estimate->matrix()) << "frame " << k;
+      }
       EXPECT_FALSE(frames[k].selection.has_value()) << "frame " << k;
     } else {
       EXPECT_TRUE(frames[k].selection.has_value()) << "frame " << k;

@@ -184,15 +184,13 @@ void Odometry::set_lidars(std::vector<LidarSetup> lidars) {
   features_ = std::vector<LidarFeatures>(lidars_.size());
 }
 
-BodyVelocity Odometry::latest_velocity() const {
-  if (centroid_poses_.size() < 2) return {};
-  const auto& a = centroid_poses_[centroid_poses_.size() - 2];
-  const auto& b = centroid_poses_.back();
-  if (!(b.stamp > a.stamp)) return {};
-  return BodyVelocity::from_relative_pose(a.T_world_base.inverse() * b.T_world_base, b.stamp - a.stamp);
-}
-
 namespace {
+
+/// The constant velocity that moves the base from `from` to `to` (zero unless `to` is later).
+BodyVelocity velocity_between(const StampedPose& from, const StampedPose& to) {
+  if (!(to.stamp > from.stamp)) return {};
+  return BodyVelocity::from_relative_pose(from.T_world_base.inverse() * to.T_world_base, to.stamp - from.stamp);
+}
 
 /// World points and covariances of one block's features (eq 4.29 through the LiDAR's compounded world pose).
 void append_covariant(const UncertainPose& T_world_lidar, const SE3& T_lidar_base, const SE3& T_world_base,
@@ -274,13 +272,15 @@ std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, c
   return report;
 }
 
-void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_unmapped) {
+void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_unmapped, bool second_lost) {
   const BodyVelocity velocity = latest_velocity();
   // World so far: the base at the first centroid (at T_world_origin_), whose pose from the first stamp is Exp(t_c v):
   // the first stamp's pose becomes T_world_origin_.
   const SE3 T_stamp_centroid = velocity.pose_at(first_centroid_time);
   const SE3 shift = T_world_origin_ * T_stamp_centroid * T_world_origin_.inverse();
   for (auto& pose : centroid_poses_) pose.T_world_base = shift * pose.T_world_base;
+  last_registered_.T_world_base = shift * last_registered_.T_world_base;
+  if (!second_lost) velocity_ = velocity_between(centroid_poses_.front(), centroid_poses_.back());  // the same, in the new world
   edge_map_ = VoxelMap(config_.edge_voxel_m, config_.edge_points_per_voxel);
   plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);
   // The first frame defines the world (no pose doubt); the second is registered against it alone, its
@@ -337,10 +337,10 @@ TrustRule Odometry::trust_rule() const {
 }
 
 void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, FrameResult& result) {
-  // Eq 4.12 again with the velocity from the previous centroid to this registration: the
+  // Eq 4.12 again with the velocity from the last registered centroid to this registration: the
   // predicted one lags a frame, which left the map (and an auxiliary LiDAR calibrated
   // against it) with a shared error under handheld motion (docs/benchmarks.md).
-  const StampedPose& previous = centroid_poses_.back();
+  const StampedPose& previous = velocity_anchor();
   const BodyVelocity measured =
       BodyVelocity::from_relative_pose(previous.T_world_base.inverse() * result.registration.T_world_base, centroid_stamp - previous.stamp);
   redeskew(frame_features_.edge_times, used, measured, frame_features_.edges);
@@ -548,9 +548,9 @@ FrameResult Odometry::process(const Frame& frame) {
     T_world_centroid = T_world_origin_;
   } else {
     std::optional<MotionDeskew> motion;
-    if (config_.deskew_in_registration && centroid_poses_.size() >= 2 && centroid_stamp > centroid_poses_.back().stamp)
-      motion = MotionDeskew{frame_features_.edge_times, frame_features_.plane_times, centroid_poses_.back().T_world_base,
-                            centroid_stamp - centroid_poses_.back().stamp, velocity};
+    if (config_.deskew_in_registration && centroid_poses_.size() >= 2 && centroid_stamp > velocity_anchor().stamp)
+      motion = MotionDeskew{frame_features_.edge_times, frame_features_.plane_times, velocity_anchor().T_world_base,
+                            centroid_stamp - velocity_anchor().stamp, velocity};
     result.registration = register_robustly(prediction, centroid_stamp, motion ? &*motion : nullptr, result);
     const BodyVelocity deskewed_with = result.registration.velocity_used.value_or(velocity);
     if (result.registration.velocity_used) apply_registered_deskew(velocity, deskewed_with);
@@ -574,9 +574,9 @@ FrameResult Odometry::process(const Frame& frame) {
     first_features_ = frame_features_;
     first_blocks_ = frame_blocks_;
   }
-  push_centroid_pose({centroid_stamp, T_world_centroid});
+  push_centroid_pose({centroid_stamp, T_world_centroid}, centroid_poses_.empty() || !result.lost());
   if (segment_frames_ == 2) {
-    restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.flagged());
+    restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.flagged(), result.lost());
     result.registration.T_world_base = centroid_poses_.back().T_world_base;
   } else if (result.trust == Trust::kTrusted) {
     // The first frame defines the world: no pose doubt.
@@ -612,8 +612,12 @@ bool Odometry::restart_due(const Frame& frame) const {
   return std::any_of(frame.scans.begin(), frame.scans.end(), [](const Scan& scan) { return !scan.empty(); });
 }
 
-void Odometry::push_centroid_pose(const StampedPose& pose) {
-  // The velocity needs the last two; the second frame of a map also the first.
+void Odometry::push_centroid_pose(const StampedPose& pose, bool registered) {
+  if (registered) {
+    if (!centroid_poses_.empty()) velocity_ = velocity_between(last_registered_, pose);
+    last_registered_ = pose;
+  }
+  // The prediction needs the last; the second frame of a map also the first.
   if (centroid_poses_.size() == 2) centroid_poses_.erase(centroid_poses_.begin());
   centroid_poses_.push_back(pose);
   ++segment_frames_;
@@ -622,6 +626,7 @@ void Odometry::push_centroid_pose(const StampedPose& pose) {
 void Odometry::start_over(const SE3& T_world_origin) {
   T_world_origin_ = T_world_origin;
   centroid_poses_.clear();
+  velocity_ = {};
   segment_frames_ = 0;
   edge_map_ = VoxelMap(config_.edge_voxel_m, config_.edge_points_per_voxel);
   plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);

@@ -215,8 +215,12 @@ class Odometry {
   const std::vector<LidarFeatures>& lidar_features() const { return features_; }
 
  private:
-  /// Constant velocity between the last two centroid poses (zero before two).
-  BodyVelocity latest_velocity() const;
+  /// The constant velocity of the prediction: between the last registered centroid pose and the one before it
+  /// that was registered (zero before two). Lost frames' poses are predictions with this velocity.
+  BodyVelocity latest_velocity() const { return velocity_; }
+  /// Where a velocity measured at this frame starts: the last registered centroid pose. After lost frames the last
+  /// pose is a prediction, and a velocity from it would put the whole gap's prediction error into one frame's time.
+  const StampedPose& velocity_anchor() const { return last_registered_; }
   RegistrationResult register_robustly(const SE3& prediction, double centroid_stamp, const MotionDeskew* motion, FrameResult& frame);
   /// After a registration with MotionDeskew: the frame's features deskewed with the velocity it ended with.
   void apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered);
@@ -257,7 +261,7 @@ class Odometry {
   /// At the second frame, once a velocity is known: moves the world from the
   /// first frame's centroid pose to its stamp pose and rebuilds the map from
   /// the first two frames' features deskewed with that velocity.
-  void restart_with_first_velocity(double first_centroid_time, bool second_unmapped);
+  void restart_with_first_velocity(double first_centroid_time, bool second_unmapped, bool second_lost);
   /// A new local map from the next frame on, as at the start but with its first pose T_world_origin: the maps, the
   /// pose history, the velocity and the threshold's history are forgotten; the recent residuals (the scene's fit)
   /// are kept.
@@ -266,8 +270,9 @@ class Odometry {
   bool restart_due(const Frame& frame) const;
   /// The constant-velocity prediction of the base at a centroid stamp (T_world_origin_ before any frame).
   SE3 predicted_centroid_pose(double centroid_stamp) const;
-  /// Keeps the last two centroid poses (the velocity's) and counts the map's frames.
-  void push_centroid_pose(const StampedPose& pose);
+  /// Keeps the last two centroid poses, counts the map's frames and, for a `registered` pose (not a lost frame's
+  /// prediction; a map's first frame is registered), measures the velocity from the anchor to it.
+  void push_centroid_pose(const StampedPose& pose, bool registered);
 
   OdometryConfig config_;
   std::vector<LidarSetup> lidars_;
@@ -281,6 +286,8 @@ class Odometry {
   VoxelMap edge_map_;
   VoxelMap plane_map_;
   std::vector<StampedPose> centroid_poses_;  ///< T_world_base at the last two frames' time centroids
+  StampedPose last_registered_;              ///< the last centroid pose not a prediction (velocity_anchor)
+  BodyVelocity velocity_;                    ///< latest_velocity
   std::size_t segment_frames_ = 0;           ///< frames since the start (or the last start_over)
   SE3 T_world_origin_;                       ///< the first frame's centroid pose (identity; after start_over, a prediction)
   std::size_t lost_in_a_row_ = 0;            ///< frames with features lost since the last one registered
