@@ -1,9 +1,9 @@
 #include "mlidar/calib/extrinsic_check.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
+#include "mlidar/core/fixed_decimals.hpp"
 #include "mlidar/core/median.hpp"
 
 namespace mlidar::calib {
@@ -45,15 +45,6 @@ std::vector<std::size_t> ExtrinsicCheck::update(std::span<const double> mean_res
   return fired;
 }
 
-namespace {
-
-std::string one_decimal(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f", value);
-  return text;
-}
-
-}  // namespace
 
 std::string describe(const DisagreementEvidence& evidence) {
   const std::string at = "at frame " + std::to_string(evidence.frame);
@@ -61,9 +52,9 @@ std::string describe(const DisagreementEvidence& evidence) {
     return "the frames after the first could not be registered with the given extrinsics (lost from the start): any of them "
            "may be wrong";
   if (evidence.map_ratio > 0.0)
-    return at + " its points in the map lay " + one_decimal(evidence.map_ratio) +
+    return at + " its points in the map lay " + fixed(evidence.map_ratio, 1) +
            "x farther from the other LiDARs' surfaces than from its own; right extrinsics stay near 1";
-  return at + " its residual was " + one_decimal(evidence.residual_ratio) + "x " + evidence.reference +
+  return at + " its residual was " + fixed(evidence.residual_ratio, 1) + "x " + evidence.reference +
          "'s, the median of the last extrinsic_check.frames frames; right extrinsics stay near 1";
 }
 

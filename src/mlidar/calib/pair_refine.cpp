@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 
 #include "mlidar/core/conversions.hpp"
 #include "mlidar/core/covariance.hpp"
+#include "mlidar/core/fixed_decimals.hpp"
 
 namespace mlidar::calib {
 namespace {
@@ -29,14 +29,6 @@ double overlap_fitness(const KdTree3f& ref_tree, std::span<const Eigen::Vector3f
     near += ref_tree.knn(mapped.cast<float>(), 1).front().distance_sq < radius_sq ? 1 : 0;
   }
   return static_cast<double>(near) / static_cast<double>(target.size());
-}
-
-std::string fixed(double value, int digits) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(digits);
-  out << value;
-  return out.str();
 }
 
 double rotation_deg_between(const SE3& a, const SE3& b) { return rad_to_deg(so3_log(a.rotation().inverse() * b.rotation()).norm()); }

@@ -3,22 +3,17 @@
 #include <cmath>
 #include <cstdio>
 
+#include "mlidar/core/fixed_decimals.hpp"
+
 namespace mlidar::eval {
 namespace {
 
 nlohmann::json number_or_null(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
-std::string fixed(double value, int decimals = 4) {
-  if (!std::isfinite(value)) return "-";
-  char buffer[48];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
-  return buffer;
-}
-
 std::string stats_row(const char* label, const ErrorStats& stats) {
   char buffer[200];
-  std::snprintf(buffer, sizeof(buffer), "%-26s %10s %10s %10s %10s\n", label, fixed(stats.rmse).c_str(), fixed(stats.mean).c_str(),
-                fixed(stats.median).c_str(), fixed(stats.max).c_str());
+  std::snprintf(buffer, sizeof(buffer), "%-26s %10s %10s %10s %10s\n", label, fixed(stats.rmse, 4).c_str(), fixed(stats.mean, 4).c_str(),
+                fixed(stats.median, 4).c_str(), fixed(stats.max, 4).c_str());
   return buffer;
 }
 
@@ -113,7 +108,7 @@ std::string format_table(const TrajectoryReport& report) {
   text += stats_row((rpe + " trans (%)").c_str(), report.rpe.translation_percent);
   text += stats_row((rpe + " rot (deg)").c_str(), report.rpe.rotation_deg);
   if (report.kitti.has_value()) {
-    text += "KITTI odometry: " + fixed(report.kitti->translation_percent) + " %, " + fixed(report.kitti->rotation_deg_per_100m) +
+    text += "KITTI odometry: " + fixed(report.kitti->translation_percent, 4) + " %, " + fixed(report.kitti->rotation_deg_per_100m, 4) +
             " deg/100m over " + std::to_string(report.kitti->segments) + " segments\n";
   } else {
     text += "KITTI odometry: path shorter than 100 m, not computed\n";
@@ -127,8 +122,8 @@ std::string format_table(const std::vector<ExtrinsicError>& errors) {
   std::string text = line;
   for (const ExtrinsicError& error : errors) {
     const std::string nees = error.nees.has_value() ? fixed(*error.nees, 3) + (error.nees_within_95() ? " ok" : " OUT") : std::string("-");
-    std::snprintf(line, sizeof(line), "%-16s %12s %12s %12s\n", error.name.c_str(), fixed(error.rotation_error_deg).c_str(),
-                  fixed(error.translation_error_m).c_str(), nees.c_str());
+    std::snprintf(line, sizeof(line), "%-16s %12s %12s %12s\n", error.name.c_str(), fixed(error.rotation_error_deg, 4).c_str(),
+                  fixed(error.translation_error_m, 4).c_str(), nees.c_str());
     text += line;
   }
   return text;
@@ -137,7 +132,7 @@ std::string format_table(const std::vector<ExtrinsicError>& errors) {
 std::string format_table(const MapMetrics& metrics, const MapMetricsOptions& options) {
   return "points: " + std::to_string(metrics.points) + " (" + std::to_string(metrics.points_used) +
          " with a full-rank neighbourhood, radius " + fixed(options.radius, 3) + " m)\n" +
-         "mean map entropy:    " + fixed(metrics.mean_map_entropy) + "\n" +
+         "mean map entropy:    " + fixed(metrics.mean_map_entropy, 4) + "\n" +
          "mean plane variance: " + fixed(metrics.mean_plane_variance, 8) + " m^2\n" +
          (metrics.covariance_trace
               ? "point covariance tr(Sigma): mean " + fixed(metrics.covariance_trace->mean, 6) + ", median " +

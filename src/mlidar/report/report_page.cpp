@@ -1,6 +1,5 @@
 // report.html assembled from its sections (run_report.hpp).
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "mlidar/core/error.hpp"
@@ -23,13 +22,6 @@ constexpr const char* kStyle =
     "@media print{nav{display:none}section{break-inside:avoid}}";
 
 }  // namespace
-
-std::string fixed(double value, int digits) {
-  if (!std::isfinite(value)) return "-";
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", digits, value);
-  return buffer;
-}
 
 double number_of(const nlohmann::json& value) { return value.is_number() ? value.get<double>() : std::nan(""); }
 

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "mlidar/core/fixed_decimals.hpp"
 #include "mlidar/report/run_report.hpp"
 #include "mlidar/report/svg_chart.hpp"
 
@@ -24,9 +25,6 @@ Chart spatial_view(const std::string& title, int horizontal, int vertical);
 
 /// A table whose cells are given as HTML (escape text first).
 std::string html_table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
-
-/// Fixed-point text of `value` with `digits` decimals; "-" for a NaN.
-std::string fixed(double value, int digits);
 
 /// A number of a JSON value, NaN when it is null or not a number.
 double number_of(const nlohmann::json& value);
