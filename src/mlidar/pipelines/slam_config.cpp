@@ -287,7 +287,7 @@ std::vector<Field> selection_fields(SlamConfig& c) {
       {"selection",
        "max_frame_gap_s",
        {0.0, 1e6},
-       "frames more than this long after the previous one register every feature (s)",
+       "frames more than this long after the last registered one register every feature (s)",
        &sel.max_frame_gap_s},
       {"selection",
        "while_calibrating",

@@ -79,9 +79,10 @@ struct SelectionConfig {
   double held_out_share = 0.25;
   double held_out_residual_ratio = 1.5;
   double held_out_residual_floor_m = 0.01;
-  /// Frames more than this long after the previous one register every feature. The selection picks features by
-  /// their information at the start pose, which the thesis has at 10 Hz; on real keyframes 0.5 s apart the chosen
-  /// sets settled up to 1.15 deg off unflagged where every feature stayed within 0.35 deg (docs/benchmarks.md).
+  /// Frames more than this long after the last registered one (lost frames between count as the gap) register every
+  /// feature. The selection picks features by their information at the start pose, which the thesis has at 10 Hz;
+  /// on real keyframes 0.5 s apart the chosen sets settled up to 1.15 deg off unflagged where every feature stayed
+  /// within 0.35 deg (docs/benchmarks.md).
   double max_frame_gap_s = 0.25;
   /// Read by the SLAM estimator: whether the odometries select while an extrinsic is being calibrated (online or
   /// refine; their poses and map are the calibration's input: selecting there made convergence 26 % later on campus).

@@ -306,8 +306,7 @@ RegistrationConfig Odometry::frame_registration(const SE3& prediction, double th
   RegistrationConfig config = config_.registration;
   if (mostly_voxel_samples()) config.plane_neighbors_max = config_.voxel_plane_neighbors_max;
   SelectionConfig& selection = config.selection;
-  if (selection_paused_ || centroid_stamp - centroid_poses_.back().stamp > selection.max_frame_gap_s)
-    selection.method = SelectionMethod::kNone;
+  if (selection_paused_ || centroid_stamp - velocity_anchor().stamp > selection.max_frame_gap_s) selection.method = SelectionMethod::kNone;
   if (selection.method == SelectionMethod::kNone || !selection.adaptive) return config;
   if (centroid_stamp - degeneracy_stamp_ >= selection.degeneracy_interval_s) {
     frame.full_set_degeneracy = full_set_degeneracy(frame_features_.edges, frame_features_.planes, edge_map_, plane_map_, prediction,
@@ -430,7 +429,7 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, double cen
   // After a long gap the constant-velocity prediction says little, and one
   // alignment that fits is no evidence that it is the only one: the retries
   // run and decide, rivals included.
-  const bool long_gap = centroid_stamp - centroid_poses_.back().stamp > config_.always_retry_after_s;
+  const bool long_gap = centroid_stamp - velocity_anchor().stamp > config_.always_retry_after_s;
   if (rule.trusted(candidates.front()) && !long_gap) {
     frame.trust = judge_degenerate_correction(Trust::kTrusted, candidates.front(), prediction, config_.trust);
     if (frame.trust == Trust::kTrusted) return std::move(candidates.front());

@@ -98,8 +98,8 @@ struct OdometryConfig {
   /// (10 Hz rigs, the prediction a few cm off) keep the prediction: there it neither saved time nor changed the
   /// accuracy beyond noise.
   int voxel_coarse_stride = 8;
-  /// Frames this long after the previous one (seconds) always run the retries
-  /// and are judged with their rivals, trusted first registration or not.
+  /// Frames this long after the last registered one (seconds; lost frames between count as the gap: empty scans and
+  /// absent frames alike) always run the retries and are judged with their rivals, trusted first registration or not.
   double always_retry_after_s = 1.5;
   /// After this many frames in a row whose registration failed (lost with features; frames without any, a gap in
   /// the input, are not counted), the next frame with points starts a new local map at its predicted pose (0: never):
