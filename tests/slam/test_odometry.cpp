@@ -344,6 +344,35 @@ TEST(Odometry, TheMotionAfterAGapInTheMiddleOfADriveIsMeasuredAsBeforeIt) { foll
 // too far along the road, frame after frame (ATE 18 m over 100 frames).
 TEST(Odometry, AFrameAfterATwoSecondGapDoesNotSendTheDriveAway) { follow_drive_across_a_gap(3, 60, 30, 49, 0.05); }
 
+// The right RS-LiDAR-16 alone (rolled 15 deg towards the ground on its side of the road) after 2 s without scans: its
+// first frames after the gap fit the map only where the ground and a few walls pin them, degenerate, and went wrong
+// (13 m off, flagged). A degenerate registration that stays near its prediction was trusted, but that prediction
+// came from the wrong frames: 5 pairs 0.2-3.4 m / up to 61 deg off were trusted. A degenerate registration is now
+// trusted only when the frame before it was.
+TEST(Odometry, ADegenerateFrameAfterAFlaggedOneIsNotTrusted) {
+  constexpr std::size_t kFrames = 56, kGapFirst = 30, kGapLast = 49;
+  Drive drive = simulate_drive("rv", kFrames, "vehicle", true, "campus", 3, 100);  // `simulate drive --frames 100 --seed 3`
+  const std::size_t right = 3;
+  ASSERT_EQ(drive.lidars[right].name, "right");
+  drive.lidars = {drive.lidars[right]};
+  for (Frame& frame : drive.frames) frame.scans = {frame.scans[right]};
+  for (std::size_t k = kGapFirst; k <= kGapLast; ++k) drive.frames[k].scans[0] = Scan{};
+
+  Odometry odometry({}, drive.lidars);
+  std::vector<FrameResult> results;
+  for (std::size_t k = 0; k < kFrames; ++k) results.push_back(odometry.process(drive.frames[k]));
+  std::size_t degenerate_after_the_gap = 0;
+  for (std::size_t k = kGapLast + 1; k < kFrames; ++k) degenerate_after_the_gap += results[k].registration.degenerate ? 1 : 0;
+  EXPECT_GT(degenerate_after_the_gap, 3U) << "the case this test is about";
+  for (std::size_t k = 0; k + 1 < kFrames; ++k) {
+    if (results[k].flagged() || results[k + 1].flagged()) continue;
+    const SE3 truth = drive.truth[k].inverse() * drive.truth[k + 1];
+    const SE3 error = truth.inverse() * (results[k].T_world_base.inverse() * results[k + 1].T_world_base);
+    EXPECT_LT(error.translation().norm(), 0.05) << "frames " << k << "-" << k + 1 << ", neither flagged";
+    EXPECT_LT(rotation_angle_deg(error), 0.5) << "frames " << k << "-" << k + 1 << ", neither flagged";
+  }
+}
+
 /// The drive's LiDARs with LiDAR 1's extrinsic turned 10 deg about each axis and moved 0.1 m along each (Table 4.6's
 /// injected perturbation), its doubt given as that 1-sigma times alpha = 10 (eq 4.24, left perturbation).
 std::vector<LidarSetup> with_injected_perturbation(std::vector<LidarSetup> lidars) {

@@ -431,7 +431,7 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, double cen
   // run and decide, rivals included.
   const bool long_gap = centroid_stamp - velocity_anchor().stamp > config_.always_retry_after_s;
   if (rule.trusted(candidates.front()) && !long_gap) {
-    frame.trust = judge_degenerate_correction(Trust::kTrusted, candidates.front(), prediction, config_.trust);
+    frame.trust = judge_degenerate(Trust::kTrusted, candidates.front(), prediction);
     if (frame.trust == Trust::kTrusted) return std::move(candidates.front());
   }
   // Every retry runs (not only up to the first trusted one): the first to pass
@@ -439,8 +439,16 @@ RegistrationResult Odometry::register_robustly(const SE3& prediction, double cen
   frame.retried = true;
   add_retries(prediction, threshold, motion, candidates);
   const Choice choice = choose_registration(candidates, rule);
-  frame.trust = judge_degenerate_correction(choice.trust, candidates[choice.best], prediction, config_.trust);
+  frame.trust = judge_degenerate(choice.trust, candidates[choice.best], prediction);
   return std::move(candidates[choice.best]);
+}
+
+Trust Odometry::judge_degenerate(Trust trust, const RegistrationResult& r, const SE3& prediction) const {
+  trust = judge_degenerate_correction(trust, r, prediction, config_.trust);
+  // A degenerate registration keeps the prediction along what it does not observe; after a flagged or lost frame that
+  // prediction comes from poses that may be wrong (a 2 s gap: frames trusted 3.4 m / 31 deg off, docs/benchmarks.md).
+  if (trust == Trust::kTrusted && r.degenerate && !last_frame_trusted_) return Trust::kDegenerate;
+  return trust;
 }
 
 namespace {
@@ -589,6 +597,7 @@ FrameResult Odometry::process(const Frame& frame) {
   if (centroid_poses_.size() >= 2 && !result.lost()) recent_residuals_.add(result.registration.mean_residual_m / residual_scale());
   result.seconds[static_cast<std::size_t>(Stage::kMapUpdate)] += seconds_since(start);
   result.T_world_base = centroid_poses_.back().T_world_base * latest_velocity().pose_at(-result.centroid_time);
+  last_frame_trusted_ = segment_frames_ == 1 || result.trust == Trust::kTrusted;  // a map's first frame defines its world
   if (result.map_restarted) {
     result.trust = Trust::kLost;  // mapped as the new map's first frame, its pose a prediction
   } else if (!result.lost()) {

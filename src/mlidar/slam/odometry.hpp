@@ -222,6 +222,8 @@ class Odometry {
   /// pose is a prediction, and a velocity from it would put the whole gap's prediction error into one frame's time.
   const StampedPose& velocity_anchor() const { return last_registered_; }
   RegistrationResult register_robustly(const SE3& prediction, double centroid_stamp, const MotionDeskew* motion, FrameResult& frame);
+  /// judge_degenerate_correction, and a degenerate registration after a frame not trusted is suspect (kDegenerate).
+  Trust judge_degenerate(Trust trust, const RegistrationResult& r, const SE3& prediction) const;
   /// After a registration with MotionDeskew: the frame's features deskewed with the velocity it ended with.
   void apply_registered_deskew(const BodyVelocity& used, const BodyVelocity& registered);
   /// 1 + (TrustConfig::voxel_residual_ratio - 1) x the share of voxel samples among this frame's features.
@@ -292,6 +294,7 @@ class Odometry {
   SE3 T_world_origin_;                       ///< the first frame's centroid pose (identity; after start_over, a prediction)
   std::size_t lost_in_a_row_ = 0;            ///< frames with features lost since the last one registered
   bool failed_on_voxel_samples_ = false;     ///< the last failed registration's frame was mostly voxel samples
+  bool last_frame_trusted_ = true;           ///< the last frame was trusted or a map's first (judge_degenerate)
   /// Mean |r| of the last registered (not lost) frames, each divided by its
   /// frame's residual_scale().
   ResidualHistory recent_residuals_;
