@@ -45,7 +45,6 @@ std::vector<std::size_t> ExtrinsicCheck::update(std::span<const double> mean_res
   return fired;
 }
 
-
 std::string describe(const DisagreementEvidence& evidence) {
   const std::string at = "at frame " + std::to_string(evidence.frame);
   if (evidence.frames_lost)

@@ -272,7 +272,7 @@ std::optional<MappingReport> Odometry::update_map(const SE3& T_world_centroid, c
   return report;
 }
 
-void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_unmapped, bool second_lost) {
+void Odometry::restart_with_first_velocity(double first_centroid_time, bool second_unmapped) {
   const BodyVelocity velocity = latest_velocity();
   // World so far: the base at the first centroid (at T_world_origin_), whose pose from the first stamp is Exp(t_c v):
   // the first stamp's pose becomes T_world_origin_.
@@ -280,7 +280,7 @@ void Odometry::restart_with_first_velocity(double first_centroid_time, bool seco
   const SE3 shift = T_world_origin_ * T_stamp_centroid * T_world_origin_.inverse();
   for (auto& pose : centroid_poses_) pose.T_world_base = shift * pose.T_world_base;
   last_registered_.T_world_base = shift * last_registered_.T_world_base;
-  if (!second_lost) velocity_ = velocity_between(centroid_poses_.front(), centroid_poses_.back());  // the same, in the new world
+  velocity_ = velocity_between(centroid_poses_.front(), last_registered_);  // the same, in the new world (zero: second lost)
   edge_map_ = VoxelMap(config_.edge_voxel_m, config_.edge_points_per_voxel);
   plane_map_ = VoxelMap(config_.plane_voxel_m, config_.plane_points_per_voxel);
   // The first frame defines the world (no pose doubt); the second is registered against it alone, its
@@ -339,9 +339,7 @@ void Odometry::refine_deskew(const BodyVelocity& used, double centroid_stamp, Fr
   // Eq 4.12 again with the velocity from the last registered centroid to this registration: the
   // predicted one lags a frame, which left the map (and an auxiliary LiDAR calibrated
   // against it) with a shared error under handheld motion (docs/benchmarks.md).
-  const StampedPose& previous = velocity_anchor();
-  const BodyVelocity measured =
-      BodyVelocity::from_relative_pose(previous.T_world_base.inverse() * result.registration.T_world_base, centroid_stamp - previous.stamp);
+  const BodyVelocity measured = velocity_between(velocity_anchor(), {centroid_stamp, result.registration.T_world_base});
   redeskew(frame_features_.edge_times, used, measured, frame_features_.edges);
   redeskew(frame_features_.plane_times, used, measured, frame_features_.planes);
   result.registration =
@@ -583,7 +581,7 @@ FrameResult Odometry::process(const Frame& frame) {
   }
   push_centroid_pose({centroid_stamp, T_world_centroid}, centroid_poses_.empty() || !result.lost());
   if (segment_frames_ == 2) {
-    restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.flagged(), result.lost());
+    restart_with_first_velocity(centroid_poses_.front().stamp - first_stamp_, result.flagged());
     result.registration.T_world_base = centroid_poses_.back().T_world_base;
   } else if (result.trust == Trust::kTrusted) {
     // The first frame defines the world: no pose doubt.

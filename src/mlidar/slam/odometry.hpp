@@ -263,7 +263,7 @@ class Odometry {
   /// At the second frame, once a velocity is known: moves the world from the
   /// first frame's centroid pose to its stamp pose and rebuilds the map from
   /// the first two frames' features deskewed with that velocity.
-  void restart_with_first_velocity(double first_centroid_time, bool second_unmapped, bool second_lost);
+  void restart_with_first_velocity(double first_centroid_time, bool second_unmapped);
   /// A new local map from the next frame on, as at the start but with its first pose T_world_origin: the maps, the
   /// pose history, the velocity and the threshold's history are forgotten; the recent residuals (the scene's fit)
   /// are kept.
