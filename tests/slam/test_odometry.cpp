@@ -254,15 +254,28 @@ TEST(Odometry, FollowsADrivingRigWhoseSweepsAreDistortedByTheMotion) {
   EXPECT_LT(worst.deg, 0.2);
 }
 
+/// `drive` with its LiDAR `lidar` alone.
+Drive one_lidar(Drive drive, std::size_t lidar) {
+  drive.lidars = {drive.lidars[lidar]};
+  for (Frame& frame : drive.frames) frame.scans = {frame.scans[lidar]};
+  return drive;
+}
+
+/// A gap in the input: the (only) LiDAR's scans from frame `first` to `last` replaced by empty ones.
+void blank_scans(Drive& drive, std::size_t first, std::size_t last) {
+  for (std::size_t k = first; k <= last; ++k) drive.frames[k].scans[0] = Scan{};
+}
+
 // The second frame matches a map of the first sweep alone. A single 16-beam LiDAR at 7.5 m/s matches fewer of its
 // features there than later (a feature between the first sweep's rings has too few neighbours for a plane); judged
 // by the later frames' share it was lost, the velocity never became known, and so was every later frame.
 TEST(Odometry, ASingleSixteenBeamLidarAtSpeedIsNotLostAtItsSecondFrame) {
-  Drive drive = simulate_drive("rv", 6, "vehicle", true, "campus", 2, 300);  // the scene of `simulate drive --frames 300 --seed 2`
-  drive.lidars.resize(1);                                                     // the top RS-LiDAR-16 alone
-  for (Frame& frame : drive.frames) frame.scans.resize(1);
+  // The top RS-LiDAR-16 alone, in the scene of `simulate drive --frames 300 --seed 2`.
+  const Drive drive = one_lidar(simulate_drive("rv", 6, "vehicle", true, "campus", 2, 300), 0);
   const WorstError worst = follow_drive(drive, [](std::size_t k, const FrameResult& result) {
-    if (k == 1) EXPECT_LT(result.registration.match_ratio(), TrustConfig{}.min_match_ratio) << "the case this test is about";
+    if (k == 1) {
+      EXPECT_LT(result.registration.match_ratio(), TrustConfig{}.min_match_ratio) << "the case this test is about";
+    }
   });
   EXPECT_LT(worst.m, 0.1);
   EXPECT_LT(worst.deg, 0.2);
@@ -274,10 +287,8 @@ TEST(Odometry, ASingleSixteenBeamLidarAtSpeedIsNotLostAtItsSecondFrame) {
 // pose; from there the relative motion is measured again, and only the restart frame's offset is unknown.
 TEST(Odometry, FailedRegistrationsInARowStartANewMapAndTheMotionAfterItIsMeasuredAgain) {
   constexpr std::size_t kFrames = 24, kGap = 8;
-  Drive drive = simulate_drive("rv", kFrames, "vehicle", true, "campus", 2, 300);
-  drive.lidars.resize(1);  // the top RS-LiDAR-16 alone
-  for (Frame& frame : drive.frames) frame.scans.resize(1);
-  for (std::size_t k = 1; k <= kGap; ++k) drive.frames[k].scans[0] = Scan{};
+  Drive drive = one_lidar(simulate_drive("rv", kFrames, "vehicle", true, "campus", 2, 300), 0);  // the top RS-LiDAR-16 alone
+  blank_scans(drive, 1, kGap);
 
   OdometryConfig never;
   never.restart_after_lost = 0;
@@ -312,10 +323,8 @@ TEST(Odometry, FailedRegistrationsInARowStartANewMapAndTheMotionAfterItIsMeasure
 /// be lost, every other one trusted, and each pair from the first frame after the gap on within `max_m` and 0.2 deg of
 /// the truth's motion.
 void follow_drive_across_a_gap(std::uint64_t seed, std::size_t frames, std::size_t gap_first, std::size_t gap_last, double max_m) {
-  Drive drive = simulate_drive("rv", static_cast<int>(frames), "vehicle", true, "campus", seed, 100);
-  drive.lidars.resize(1);
-  for (Frame& frame : drive.frames) frame.scans.resize(1);
-  for (std::size_t k = gap_first; k <= gap_last; ++k) drive.frames[k].scans[0] = Scan{};
+  Drive drive = one_lidar(simulate_drive("rv", static_cast<int>(frames), "vehicle", true, "campus", seed, 100), 0);
+  blank_scans(drive, gap_first, gap_last);
 
   Odometry odometry({}, drive.lidars);
   std::vector<SE3> estimates;
@@ -351,12 +360,11 @@ TEST(Odometry, AFrameAfterATwoSecondGapDoesNotSendTheDriveAway) { follow_drive_a
 // trusted only when the frame before it was.
 TEST(Odometry, ADegenerateFrameAfterAFlaggedOneIsNotTrusted) {
   constexpr std::size_t kFrames = 56, kGapFirst = 30, kGapLast = 49;
-  Drive drive = simulate_drive("rv", kFrames, "vehicle", true, "campus", 3, 100);  // `simulate drive --frames 100 --seed 3`
+  const Drive rig = simulate_drive("rv", kFrames, "vehicle", true, "campus", 3, 100);  // `simulate drive --frames 100 --seed 3`
   const std::size_t right = 3;
-  ASSERT_EQ(drive.lidars[right].name, "right");
-  drive.lidars = {drive.lidars[right]};
-  for (Frame& frame : drive.frames) frame.scans = {frame.scans[right]};
-  for (std::size_t k = kGapFirst; k <= kGapLast; ++k) drive.frames[k].scans[0] = Scan{};
+  ASSERT_EQ(rig.lidars[right].name, "right");
+  Drive drive = one_lidar(rig, right);
+  blank_scans(drive, kGapFirst, kGapLast);
 
   Odometry odometry({}, drive.lidars);
   std::vector<FrameResult> results;
@@ -575,7 +583,9 @@ TEST(Odometry, FramesFartherApartThanTheGapLimitRegisterEveryFeature) {
     const FrameResult a = plain.process(every_third[k]), b = limited.process(every_third[k]), c = selecting_all.process(every_third[k]);
     EXPECT_EQ(a.T_world_base.matrix(), b.T_world_base.matrix()) << "frame " << k;
     EXPECT_FALSE(b.registration.selection) << "frame " << k;
-    if (k > 0) EXPECT_TRUE(c.registration.selection) << "frame " << k;
+    if (k > 0) {
+      EXPECT_TRUE(c.registration.selection) << "frame " << k;
+    }
   }
 }
 
