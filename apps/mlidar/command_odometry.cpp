@@ -72,7 +72,7 @@ int run_odometry(const OdometryOptions& options, const CliContext& context) {
     std::cerr << "; that translation was held at the motion prior, not measured (metrics.json per_frame weak_direction)\n";
   }
   std::cerr << suspect_frames_warning(summary.suspect_frames);
-  std::cerr << pipelines::map_restart_warning(summary.map_restarts, summary.restart_after_lost);
+  std::cerr << summary.map_restart_warning;
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
   if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';

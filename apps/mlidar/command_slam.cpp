@@ -123,7 +123,7 @@ int run_slam(SlamOptions options, const CliContext& context) {
     std::cerr
         << "warning: some LiDAR's calibration did not converge; its extrinsic in extrinsics.yaml has no covariance (see metrics.json)\n";
   std::cerr << suspect_frames_warning(summary.suspect_frames);
-  std::cerr << pipelines::map_restart_warning(summary.map_restarts, summary.restart_after_lost);
+  std::cerr << summary.map_restart_warning;
   if (summary.lost_frames > 0) std::cerr << "warning: " << summary.lost_frames << " frame(s) could not be registered; see metrics.json\n";
   for (const auto& line : summary.gaps) std::cerr << "warning: " << line << "; see metrics.json skipped_scans\n";
   if (summary.base_failure) std::cerr << "error: " << *summary.base_failure << '\n';

@@ -39,7 +39,7 @@ TEST(SlamConfig, ExampleFileDocumentsEveryKeyWithItsDefault) {
     EXPECT_FALSE(key.range.empty());
     EXPECT_FALSE(key.meaning.empty());
   }
-  EXPECT_EQ(slam_config_keys().size(), 74u);
+  EXPECT_EQ(slam_config_keys().size(), 75u);
 }
 
 TEST(SlamConfig, EmptyDocumentAndPartialSectionsKeepDefaults) {
@@ -75,6 +75,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   c.odometry.local_map_radius_m = 80.0;
   c.odometry.registration.max_iterations = 12;
   c.odometry.restart_after_lost = 7;
+  c.odometry.restart_after_suspect = 13;
   c.odometry.registration.huber_delta_m = 0.05;
   c.odometry.refine_deskew = true;
   c.odometry.registration.selection.method = slam::SelectionMethod::kRandom;
@@ -100,6 +101,7 @@ TEST(SlamConfig, RoundTripsEveryKey) {
   EXPECT_TRUE(back.window.refine_odometry);
   EXPECT_EQ(back.odometry.registration.max_iterations, 12);
   EXPECT_EQ(back.odometry.restart_after_lost, 7u);
+  EXPECT_EQ(back.odometry.restart_after_suspect, 13u);
   EXPECT_EQ(back.odometry.registration.huber_delta_m, 0.05);
   EXPECT_TRUE(back.odometry.refine_deskew);
   EXPECT_EQ(back.odometry.registration.selection.method, slam::SelectionMethod::kRandom);
@@ -134,6 +136,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
       "  deskew_in_registration: false\n  plane_neighbors_max: 8\n  voxel_plane_neighbors_max: 6\n  plane_extra_radius_m: 0.3\n"
       "  plane_min_extent_sigmas: 0.8\n  huber_delta_m: 0.05\n"
       "  recover_rows: false\n  recover_rows_max_skip: 4\n  voxel_coarse_stride: 3\n  restart_after_lost: 9\n"
+      "  restart_after_suspect: 11\n"
       "selection:\n"
       "  method: greedy\n  ratio: 0.3\n  adaptive: false\n  degenerate_ratio: 0.7\n  degeneracy_threshold: 0.25\n"
       "  degeneracy_interval_s: 2\n  epsilon: 0.4\n  time_budget_ms: 3\n  seed: 12\n  min_features: 40\n"
@@ -192,6 +195,7 @@ TEST(SlamConfig, EachKeyOfAHandWrittenFileLandsInTheMemberOfItsName) {
   EXPECT_EQ(c.odometry.local_map_radius_m, 80.0);
   EXPECT_EQ(c.odometry.registration.max_iterations, 12);
   EXPECT_EQ(c.odometry.restart_after_lost, 9u);
+  EXPECT_EQ(c.odometry.restart_after_suspect, 11u);
   EXPECT_TRUE(c.odometry.refine_deskew);
   EXPECT_FALSE(c.odometry.deskew_in_registration);
   const slam::SelectionConfig& sel = c.odometry.registration.selection;

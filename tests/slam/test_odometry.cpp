@@ -292,6 +292,7 @@ TEST(Odometry, FailedRegistrationsInARowStartANewMapAndTheMotionAfterItIsMeasure
 
   OdometryConfig never;
   never.restart_after_lost = 0;
+  never.restart_after_suspect = 0;
   Odometry stuck(never, drive.lidars);
   std::size_t lost_after_gap = 0;
   for (std::size_t k = 0; k < kFrames; ++k) lost_after_gap += stuck.process(drive.frames[k]).lost() && k > kGap ? 1 : 0;
@@ -379,6 +380,45 @@ TEST(Odometry, ADegenerateFrameAfterAFlaggedOneIsNotTrusted) {
     EXPECT_LT(error.translation().norm(), 0.05) << "frames " << k << "-" << k + 1 << ", neither flagged";
     EXPECT_LT(rotation_angle_deg(error), 0.5) << "frames " << k << "-" << k + 1 << ", neither flagged";
   }
+}
+
+// The same gap, followed further: only trusted frames enter the map, and every frame after the gap registered
+// degenerate or ambiguous against the map left 20 m behind, so nothing was ever trusted again (checked with
+// restarts off: every frame suspect to the end, the pairs off by metres). After restart_after_suspect
+// untrusted frames in a row the next one starts a new map, and the motion after it is measured again.
+TEST(Odometry, UntrustedFramesInARowStartANewMapAndTheMotionAfterItIsMeasuredAgain) {
+  constexpr std::size_t kFrames = 72, kGapFirst = 30, kGapLast = 49;
+  const Drive rig = simulate_drive("rv", kFrames, "vehicle", true, "campus", 3, 100);
+  Drive drive = one_lidar(rig, 3);  // right
+  blank_scans(drive, kGapFirst, kGapLast);
+
+  OdometryConfig never;
+  never.restart_after_lost = 0;
+  never.restart_after_suspect = 0;
+  Odometry stuck(never, drive.lidars);
+  std::size_t flagged_after_gap = 0;
+  for (std::size_t k = 0; k < kFrames; ++k) flagged_after_gap += stuck.process(drive.frames[k]).flagged() && k > kGapLast ? 1 : 0;
+  EXPECT_EQ(flagged_after_gap, kFrames - kGapLast - 1) << "the case this test is about";
+
+  Odometry odometry({}, drive.lidars);
+  std::optional<std::size_t> restart;
+  SE3 T_world_restart;
+  for (std::size_t k = 0; k < kFrames; ++k) {
+    const FrameResult result = odometry.process(drive.frames[k]);
+    if (result.map_restarted) {
+      EXPECT_FALSE(restart) << "one restart, frame " << k;
+      restart = k;
+      T_world_restart = result.T_world_base;
+    } else if (restart) {
+      EXPECT_EQ(result.trust, Trust::kTrusted) << "frame " << k;
+      const SE3 truth = drive.truth[*restart].inverse() * drive.truth[k];
+      const SE3 error = truth.inverse() * (T_world_restart.inverse() * result.T_world_base);
+      EXPECT_LT(error.translation().norm(), 0.05) << "frame " << k;
+      EXPECT_LT(rotation_angle_deg(error), 0.2) << "frame " << k;
+    }
+  }
+  ASSERT_TRUE(restart);
+  EXPECT_EQ(*restart, kGapLast + 1 + OdometryConfig{}.restart_after_suspect);  // 10 untrusted frames, then the restart
 }
 
 /// The drive's LiDARs with LiDAR 1's extrinsic turned 10 deg about each axis and moved 0.1 m along each (Table 4.6's

@@ -161,7 +161,6 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
     if (progress) progress(static_cast<int>(k + 1), static_cast<int>(source.frames()));
   }
   summary.frames = results.size();
-  summary.restart_after_lost = config.restart_after_lost;
   for (std::size_t k = 0; k < results.size(); ++k) {
     const slam::FrameResult& r = results[k];
     summary.degenerate_frames += r.registration.degenerate ? 1 : 0;
@@ -171,6 +170,7 @@ OdometryJobSummary run_odometry_job(const OdometryJob& job, const std::function<
     if (r.suspect()) summary.suspect_frames.push_back(k);
     for (const double s : r.seconds) summary.mean_frame_seconds += s / static_cast<double>(results.size());
   }
+  summary.map_restart_warning = map_restart_warning(summary.map_restarts, config);
   summary.degenerate_directions = degenerate_direction_counts(results);
   summary.gaps = gaps.summary_lines();
   summary.front_end = front_end_lines(results, lidars, config.front_end.recover_rows);

@@ -110,14 +110,15 @@ std::string last_pose_note(const Mat6& covariance, std::size_t lost_at_end) {
          " frame(s) were lost and each adds the prediction's doubt; every frame's in pose_covariance.txt)";
 }
 
-std::string map_restart_warning(const std::vector<std::size_t>& frames, std::size_t lost_before) {
+std::string map_restart_warning(const std::vector<std::size_t>& frames, const slam::OdometryConfig& config) {
   if (frames.empty()) return {};
   std::string text = "warning: the local map was started again at frame";
   text += frames.size() == 1 ? " " : "s ";
   for (std::size_t i = 0; i < frames.size(); ++i) text += (i > 0 ? ", " : "") + std::to_string(frames[i]);
-  return text + ", after " + std::to_string(lost_before) +
-         " failed registrations in a row (odometry.restart_after_lost): the trajectory after each restart is measured "
-         "again, but joins the one before through the motion prediction alone, so the offset there is unknown "
+  return text + ", after " + std::to_string(config.restart_after_lost) +
+         " failed registrations in a row (odometry.restart_after_lost) or " + std::to_string(config.restart_after_suspect) +
+         " frames in a row not trusted (odometry.restart_after_suspect): the trajectory after each restart is "
+         "measured again, but joins the one before through the motion prediction alone, so the offset there is unknown "
          "(metrics.json map_restarts)\n";
 }
 

@@ -29,8 +29,8 @@ std::string pose_sigma_words(const Mat6& covariance);
 /// prediction whose doubt grew with each (so tens of metres after a long run of them are no estimate).
 std::string last_pose_note(const Mat6& covariance, std::size_t lost_at_end);
 
-/// The terminal's warning on frames that started a new local map; empty for none.
-std::string map_restart_warning(const std::vector<std::size_t>& frames, std::size_t lost_before);
+/// The terminal's warning on frames that started a new local map (after `config`'s restart limits); empty for none.
+std::string map_restart_warning(const std::vector<std::size_t>& frames, const slam::OdometryConfig& config);
 
 /// metrics.json per frame: `pose_covariance_trace` (m^2 + rad^2) from `covariances` (one per frame).
 void add_pose_covariance_traces(nlohmann::json& metrics, const std::vector<io::StampedCovariance>& covariances);

@@ -195,6 +195,12 @@ std::vector<Field> odometry_fields(SlamConfig& c) {
        "new local map at its predicted pose (0: never)",
        &odo.restart_after_lost},
       {"odometry",
+       "restart_after_suspect",
+       {0, 1e6},
+       "frames with points in a row not trusted (suspect or lost) after which the next frame with points starts a new local "
+       "map at its predicted pose (0: never)",
+       &odo.restart_after_suspect},
+      {"odometry",
        "refine_deskew",
        {},
        "deskew each frame again with the velocity its registration measured and register once more",

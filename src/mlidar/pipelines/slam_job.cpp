@@ -167,7 +167,6 @@ SlamJobSummary summarize(const SlamRun& run, const SlamEstimator& estimator, con
                          const SlamJob& job, const BaseFrame& frame) {
   SlamJobSummary summary;
   summary.frames = run.frames.size();
-  summary.restart_after_lost = estimator.trusted_odometry().config().restart_after_lost;
   summary.trajectory = final_trajectory(run, frame);
   summary.gaps = gaps.summary_lines();
   summary.base_failure = gaps.base_failure(job.max_base_gaps, frame.reference);
@@ -184,6 +183,7 @@ SlamJobSummary summarize(const SlamRun& run, const SlamEstimator& estimator, con
     summary.mean_frame_seconds +=
         (s.odometry + s.initialization + s.calibration + s.shock + s.window) / static_cast<double>(run.frames.size());
   }
+  summary.map_restart_warning = map_restart_warning(summary.map_restarts, estimator.trusted_odometry().config());
   return summary;
 }
 

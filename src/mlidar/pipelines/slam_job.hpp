@@ -44,8 +44,8 @@ struct SlamJobSummary {
   std::size_t frames = 0;
   std::size_t lost_frames = 0;
   std::size_t lost_at_end = 0;              ///< lost frames in a row at the end of the run (the last pose a prediction)
-  std::vector<std::size_t> map_restarts;    ///< frames that started a new local map after failed registrations in a row
-  std::size_t restart_after_lost = 0;       ///< ... after this many (odometry.restart_after_lost)
+  std::vector<std::size_t> map_restarts;    ///< frames that started a new local map after untrusted frames in a row
+  std::string map_restart_warning;          ///< the terminal's words on them (empty: none)
   std::vector<std::size_t> suspect_frames;  ///< frame indices whose base pose is doubtful
   double mean_frame_seconds = 0.0;
   Trajectory trajectory;

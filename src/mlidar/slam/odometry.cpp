@@ -598,11 +598,8 @@ FrameResult Odometry::process(const Frame& frame) {
   last_frame_trusted_ = segment_frames_ == 1 || result.trust == Trust::kTrusted;  // a map's first frame defines its world
   if (result.map_restarted) {
     result.trust = Trust::kLost;  // mapped as the new map's first frame, its pose a prediction
-  } else if (!result.lost()) {
-    lost_in_a_row_ = 0;
-  } else if (result.edge_features + result.plane_features > 0) {
-    ++lost_in_a_row_;  // a registration that failed (a frame without features, e.g. a gap in the input, is no evidence)
-    failed_on_voxel_samples_ = mostly_voxel_samples();
+  } else {
+    count_untrusted(result);
   }
   return result;
 }
@@ -612,8 +609,19 @@ SE3 Odometry::predicted_centroid_pose(double centroid_stamp) const {
   return centroid_poses_.back().T_world_base * latest_velocity().pose_at(centroid_stamp - centroid_poses_.back().stamp);
 }
 
+void Odometry::count_untrusted(const FrameResult& result) {
+  if (result.trust == Trust::kTrusted) untrusted_in_a_row_ = 0;
+  if (!result.lost()) lost_in_a_row_ = 0;
+  // A frame without features (e.g. a gap in the input) is no evidence either way.
+  if (result.trust == Trust::kTrusted || result.edge_features + result.plane_features == 0) return;
+  ++untrusted_in_a_row_;
+  if (result.lost()) ++lost_in_a_row_;
+  failed_on_voxel_samples_ = mostly_voxel_samples();
+}
+
 bool Odometry::restart_due(const Frame& frame) const {
-  if (config_.restart_after_lost == 0 || lost_in_a_row_ < config_.restart_after_lost) return false;
+  const auto reached = [](std::size_t count, std::size_t limit) { return limit > 0 && count >= limit; };
+  if (!reached(lost_in_a_row_, config_.restart_after_lost) && !reached(untrusted_in_a_row_, config_.restart_after_suspect)) return false;
   if (failed_on_voxel_samples_) return false;  // keyframes without scan rows do not restart
   return std::any_of(frame.scans.begin(), frame.scans.end(), [](const Scan& scan) { return !scan.empty(); });
 }
@@ -641,6 +649,7 @@ void Odometry::start_over(const SE3& T_world_origin) {
   error_sq_sum_ = 0.0;
   error_count_ = 0;
   lost_in_a_row_ = 0;
+  untrusted_in_a_row_ = 0;
 }
 
 }  // namespace mlidar::slam

@@ -111,6 +111,12 @@ struct OdometryConfig {
   /// keyframes 0.1-7 s apart, maps started again from one sparse keyframe let 1 wrong pair of 290 pass as trusted
   /// (docs/benchmarks.md "Failed registrations in a row start a new local map").
   std::size_t restart_after_lost = 5;
+  /// After this many frames in a row with points that were not trusted (suspect or lost), the next frame with points
+  /// starts a new local map as after restart_after_lost (0: never). Only trusted frames enter the map, so a map the
+  /// drive has left behind stays behind: after 2 s without scans (rv seed 3, scans 30-49 blanked) the right LiDAR
+  /// alone registered every later frame degenerate or ambiguous against it, 50 frames suspect and 49 pairs off, to the
+  /// end of the drive. Frames of voxel samples never restart (as restart_after_lost).
+  std::size_t restart_after_suspect = 10;
   /// After a trusted registration, deskew the frame's features again with the
   /// velocity it measured (the prediction's is a frame late) and register once
   /// more from there, before they enter the map. Off: it costs a second
@@ -162,7 +168,8 @@ struct FrameResult {
   /// No acceptable registration: the pose is the prediction, not mapped (except by a map_restarted frame).
   bool lost() const { return trust == Trust::kLost; }
   /// This frame started a new local map at its predicted pose after OdometryConfig::restart_after_lost frames lost
-  /// in a row (it is lost: the trajectory after it joins the one before through the prediction alone).
+  /// or restart_after_suspect not trusted in a row (it is lost: the trajectory after it joins the one before through
+  /// the prediction alone).
   bool map_restarted = false;
   /// Acceptable but not trusted (`trust` says why): the pose is kept, not mapped.
   bool suspect() const { return trust == Trust::kResidual || trust == Trust::kAmbiguous || trust == Trust::kDegenerate; }
@@ -268,8 +275,12 @@ class Odometry {
   /// pose history, the velocity and the threshold's history are forgotten; the recent residuals (the scene's fit)
   /// are kept.
   void start_over(const SE3& T_world_origin);
-  /// OdometryConfig::restart_after_lost failed registrations in a row (not of voxel samples), and this frame has points.
+  /// OdometryConfig::restart_after_lost failed or restart_after_suspect untrusted registrations in a row (not of
+  /// voxel samples), and this frame has points.
   bool restart_due(const Frame& frame) const;
+  /// Counts the frame (with features) towards restart_due when it was not trusted; a trusted one resets both counts,
+  /// a registered one the lost count.
+  void count_untrusted(const FrameResult& result);
   /// The constant-velocity prediction of the base at a centroid stamp (T_world_origin_ before any frame).
   SE3 predicted_centroid_pose(double centroid_stamp) const;
   /// Keeps the last two centroid poses, counts the map's frames and, for a `registered` pose (not a lost frame's
@@ -293,7 +304,8 @@ class Odometry {
   std::size_t segment_frames_ = 0;           ///< frames since the start (or the last start_over)
   SE3 T_world_origin_;                       ///< the first frame's centroid pose (identity; after start_over, a prediction)
   std::size_t lost_in_a_row_ = 0;            ///< frames with features lost since the last one registered
-  bool failed_on_voxel_samples_ = false;     ///< the last failed registration's frame was mostly voxel samples
+  std::size_t untrusted_in_a_row_ = 0;       ///< frames with features suspect or lost since the last one trusted
+  bool failed_on_voxel_samples_ = false;     ///< the last untrusted registration's frame was mostly voxel samples
   bool last_frame_trusted_ = true;           ///< the last frame was trusted or a map's first (judge_degenerate)
   /// Mean |r| of the last registered (not lost) frames, each divided by its
   /// frame's residual_scale().
