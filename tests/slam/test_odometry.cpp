@@ -281,6 +281,37 @@ TEST(Odometry, ASingleSixteenBeamLidarAtSpeedIsNotLostAtItsSecondFrame) {
   EXPECT_LT(worst.deg, 0.2);
 }
 
+/// A default configuration that never starts a new map.
+OdometryConfig without_restarts() {
+  OdometryConfig never;
+  never.restart_after_lost = 0;
+  never.restart_after_suspect = 0;
+  return never;
+}
+
+/// Each frame's result of a default odometry over `drive`. At most one frame may start a new map (the first with
+/// map_restarted, also returned), and every frame after it must be within 5 cm / 0.2 deg of the truth's motion from
+/// that frame: the motion after a restart is measured again, only the restart frame's offset is unknown.
+std::pair<std::vector<FrameResult>, std::optional<std::size_t>> follow_drive_through_one_restart(const Drive& drive) {
+  Odometry odometry({}, drive.lidars);
+  std::vector<FrameResult> results;
+  std::optional<std::size_t> restart;
+  for (std::size_t k = 0; k < drive.frames.size(); ++k) {
+    results.push_back(odometry.process(drive.frames[k]));
+    const FrameResult& result = results.back();
+    if (result.map_restarted) {
+      EXPECT_FALSE(restart) << "one restart, frame " << k;
+      restart = k;
+    } else if (restart) {
+      const SE3 truth = drive.truth[*restart].inverse() * drive.truth[k];
+      const SE3 error = truth.inverse() * (results[*restart].T_world_base.inverse() * result.T_world_base);
+      EXPECT_LT(error.translation().norm(), 0.05) << "frame " << k;
+      EXPECT_LT(rotation_angle_deg(error), 0.2) << "frame " << k;
+    }
+  }
+  return {results, restart};
+}
+
 // A gap in the input right after the first frame (no scan for 0.8 s at 7.5 m/s): the velocity was never measured, so
 // the prediction stays at the start, 6 m behind, where the registrations fail (checked with restarts off: every
 // later frame lost). After restart_after_lost failed registrations the next frame starts a new map at its predicted
@@ -290,32 +321,14 @@ TEST(Odometry, FailedRegistrationsInARowStartANewMapAndTheMotionAfterItIsMeasure
   Drive drive = one_lidar(simulate_drive("rv", kFrames, "vehicle", true, "campus", 2, 300), 0);  // the top RS-LiDAR-16 alone
   blank_scans(drive, 1, kGap);
 
-  OdometryConfig never;
-  never.restart_after_lost = 0;
-  never.restart_after_suspect = 0;
-  Odometry stuck(never, drive.lidars);
+  Odometry stuck(without_restarts(), drive.lidars);
   std::size_t lost_after_gap = 0;
   for (std::size_t k = 0; k < kFrames; ++k) lost_after_gap += stuck.process(drive.frames[k]).lost() && k > kGap ? 1 : 0;
   EXPECT_EQ(lost_after_gap, kFrames - kGap - 1) << "the case this test is about";
 
-  Odometry odometry({}, drive.lidars);
-  std::optional<std::size_t> restart;
-  SE3 T_world_restart;
-  for (std::size_t k = 0; k < kFrames; ++k) {
-    const FrameResult result = odometry.process(drive.frames[k]);
-    EXPECT_EQ(result.lost(), k > 0 && (k <= kGap || !restart || k == *restart)) << "frame " << k;
-    if (result.map_restarted) {
-      EXPECT_FALSE(restart) << "one restart, frame " << k;
-      restart = k;
-      T_world_restart = result.T_world_base;
-    } else if (restart && k > *restart) {
-      const SE3 truth = drive.truth[*restart].inverse() * drive.truth[k];
-      const SE3 error = truth.inverse() * (T_world_restart.inverse() * result.T_world_base);
-      EXPECT_LT(error.translation().norm(), 0.05) << "frame " << k;
-      EXPECT_LT(rotation_angle_deg(error), 0.2) << "frame " << k;
-    }
-  }
+  const auto [results, restart] = follow_drive_through_one_restart(drive);
   ASSERT_TRUE(restart);
+  for (std::size_t k = 0; k < kFrames; ++k) EXPECT_EQ(results[k].lost(), k > 0 && (k <= kGap || k <= *restart)) << "frame " << k;
   EXPECT_EQ(*restart, kGap + 1 + OdometryConfig{}.restart_after_lost);  // 5 failed registrations, then the restart
 }
 
@@ -392,32 +405,14 @@ TEST(Odometry, UntrustedFramesInARowStartANewMapAndTheMotionAfterItIsMeasuredAga
   Drive drive = one_lidar(rig, 3);  // right
   blank_scans(drive, kGapFirst, kGapLast);
 
-  OdometryConfig never;
-  never.restart_after_lost = 0;
-  never.restart_after_suspect = 0;
-  Odometry stuck(never, drive.lidars);
+  Odometry stuck(without_restarts(), drive.lidars);
   std::size_t flagged_after_gap = 0;
   for (std::size_t k = 0; k < kFrames; ++k) flagged_after_gap += stuck.process(drive.frames[k]).flagged() && k > kGapLast ? 1 : 0;
   EXPECT_EQ(flagged_after_gap, kFrames - kGapLast - 1) << "the case this test is about";
 
-  Odometry odometry({}, drive.lidars);
-  std::optional<std::size_t> restart;
-  SE3 T_world_restart;
-  for (std::size_t k = 0; k < kFrames; ++k) {
-    const FrameResult result = odometry.process(drive.frames[k]);
-    if (result.map_restarted) {
-      EXPECT_FALSE(restart) << "one restart, frame " << k;
-      restart = k;
-      T_world_restart = result.T_world_base;
-    } else if (restart) {
-      EXPECT_EQ(result.trust, Trust::kTrusted) << "frame " << k;
-      const SE3 truth = drive.truth[*restart].inverse() * drive.truth[k];
-      const SE3 error = truth.inverse() * (T_world_restart.inverse() * result.T_world_base);
-      EXPECT_LT(error.translation().norm(), 0.05) << "frame " << k;
-      EXPECT_LT(rotation_angle_deg(error), 0.2) << "frame " << k;
-    }
-  }
+  const auto [results, restart] = follow_drive_through_one_restart(drive);
   ASSERT_TRUE(restart);
+  for (std::size_t k = *restart + 1; k < kFrames; ++k) EXPECT_EQ(results[k].trust, Trust::kTrusted) << "frame " << k;
   EXPECT_EQ(*restart, kGapLast + 1 + OdometryConfig{}.restart_after_suspect);  // 10 untrusted frames, then the restart
 }
 
